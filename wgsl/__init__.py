@@ -1,0 +1,1 @@
+"""Package data: shipped as wgpuviewer.wgsl (see pyproject.toml)."""
