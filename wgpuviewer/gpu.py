@@ -10,6 +10,8 @@ import os
 import sys
 from dataclasses import dataclass, field
 
+import cv2
+import numpy as np
 import wgpu
 
 from .errors import NoAdapterError, UserError
@@ -71,6 +73,8 @@ class Gpu:
     adapter: wgpu.GPUAdapter
     device: wgpu.GPUDevice
     features: frozenset[str] = field(default_factory=frozenset)
+    #: Per-device caches (pipelines, layouts), keyed by their users.
+    cache: dict = field(default_factory=dict)
 
     @property
     def summary(self) -> str:
@@ -122,3 +126,65 @@ def describe_adapters(backend: str | None = None) -> str:
         )
     )
     return "\n".join(lines)
+
+
+# --- resource helpers shared by the renderer, the probe and the viewer ------------------------
+
+_TEXEL = {  # format -> (numpy dtype, channels)
+    "r32float": (np.float32, 1),
+    "r16float": (np.float16, 1),
+    "rgba16float": (np.float16, 4),
+    "rgba8unorm": (np.uint8, 4),
+    "rgba8unorm-srgb": (np.uint8, 4),
+}
+
+
+def to_texel_data(data: np.ndarray, fmt: str) -> np.ndarray:
+    """(H, W) or (H, W, C) floats in [0, 1] -> contiguous texel array for ``fmt``."""
+    dtype, channels = _TEXEL[fmt]
+    a = np.asarray(data, dtype=np.float32)
+    if a.ndim == 2:
+        a = a[:, :, None]
+    if a.shape[2] < channels:  # pad missing channels with 1 (alpha)
+        a = np.concatenate([a, np.ones(a.shape[:2] + (channels - a.shape[2],), np.float32)], axis=2)
+    a = a[:, :, :channels]
+    if dtype == np.uint8:
+        a = np.clip(np.rint(a * 255.0), 0, 255)
+    return np.ascontiguousarray(a.astype(dtype))
+
+
+def create_texture(gpu: Gpu, levels: list[np.ndarray], fmt: str, label: str) -> wgpu.GPUTexture:
+    """A sampled 2D texture from a mip chain (``levels[0]`` is the base level)."""
+    base = levels[0]
+    h, w = base.shape[:2]
+    limit = gpu.adapter.limits["max-texture-dimension-2d"]
+    if max(w, h) > limit:
+        raise UserError(f"{label}: texture of {w}x{h} exceeds this adapter's limit of {limit} texels per side")
+    texture = gpu.device.create_texture(
+        label=label,
+        size=(w, h, 1),
+        format=fmt,
+        usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
+        mip_level_count=len(levels),
+    )
+    for level, data in enumerate(levels):
+        texels = to_texel_data(data, fmt)
+        lh, lw = texels.shape[:2]
+        gpu.device.queue.write_texture(
+            {"texture": texture, "mip_level": level, "origin": (0, 0, 0)},
+            texels,
+            {"offset": 0, "bytes_per_row": texels.strides[0], "rows_per_image": lh},
+            (lw, lh, 1),
+        )
+    return texture
+
+
+def mip_chain(data: np.ndarray) -> list[np.ndarray]:
+    """Average (box-filtered) mip chain down to 1x1; odd sizes round down as WebGPU mips do."""
+    levels = [np.asarray(data, np.float32)]
+    while max(levels[-1].shape[:2]) > 1:
+        h, w = levels[-1].shape[:2]
+        levels.append(cv2.resize(levels[-1], (max(w // 2, 1), max(h // 2, 1)), interpolation=cv2.INTER_AREA))
+        if levels[-1].ndim < levels[0].ndim:  # cv2 drops a trailing channel axis of size 1
+            levels[-1] = levels[-1][..., None]
+    return levels

@@ -12,9 +12,10 @@ from dataclasses import dataclass, field
 
 from .errors import UserError
 
-#: Fields of the WGSL ``TraceParams`` uniform (all f32, in this order). ``height_scale`` comes from
-#: the material; ``lod`` is set per call (0 for the probe); the rest are technique parameters.
-TRACE_FIELDS = ("height_scale", "lod", "layers", "offset_limiting")
+#: Fields of the WGSL ``TraceParams`` uniform (all f32, in this order). ``height_scale`` and the
+#: depth map's size in texels (for the mip level) come from the material; the rest are technique
+#: parameters (0 where a technique has no such parameter).
+TRACE_FIELDS = ("height_scale", "depth_width", "depth_height", "layers", "offset_limiting")
 
 #: Hard cap on any layer count, mirrored by ``MAX_LAYERS`` in the WGSL prelude.
 MAX_LAYERS = 1024

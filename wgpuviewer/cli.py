@@ -1,0 +1,146 @@
+"""Command line: ``wgpuviewer view|render|techniques|info``."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from .errors import UserError
+from .gpu import BACKEND_CHOICES, BACKEND_ENV
+
+DEFAULT_SIZE = (1280, 720)
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(part) for part in text.lower().split("x"))
+    except ValueError:
+        raise UserError(f"--size {text!r}: expected WIDTHxHEIGHT, e.g. 1280x720") from None
+    if not (1 <= w <= 16384 and 1 <= h <= 16384):
+        raise UserError(f"--size {text!r}: width and height must be 1 to 16384")
+    return w, h
+
+
+def load_scene_arg(path: str | None):
+    from .scene import default_scene_path, load_scene
+
+    return load_scene(Path(path) if path else default_scene_path())
+
+
+def pick_technique(scene, name: str | None) -> str:
+    from .techniques import get_technique
+
+    return get_technique(name or scene.technique, "--technique").name
+
+
+def has_display() -> bool:
+    if sys.platform.startswith("linux"):
+        return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    return True
+
+
+def cmd_render(args) -> int:
+    from .gpu import get_gpu
+    from .output import OUTPUT_SUFFIXES, save_output
+    from .renderer import Renderer
+
+    out = Path(args.output)
+    if out.suffix.lower() not in OUTPUT_SUFFIXES:
+        raise UserError(f"-o {out}: unknown output type {out.suffix!r}; use .png (image) or .npy (raw float32 data)")
+    scene = load_scene_arg(args.scene)
+    technique = pick_technique(scene, args.technique)
+    size = parse_size(args.size) if args.size else DEFAULT_SIZE
+    renderer = Renderer(scene, get_gpu(args.backend))
+    save_output(out, renderer.render(technique, size), args.mode)
+    print(out)
+    return 0
+
+
+def cmd_view(args) -> int:
+    scene = load_scene_arg(args.scene)
+    technique = pick_technique(scene, args.technique)
+    if not has_display():
+        from .gpu import get_gpu
+        from .output import save_output
+        from .renderer import Renderer
+
+        out = Path("out") / f"{Path(scene.path).stem if scene.path else 'scene'}_{technique}.png"
+        print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the scene to {out} instead")
+        renderer = Renderer(scene, get_gpu(args.backend))
+        save_output(out, renderer.render(technique, DEFAULT_SIZE), "color")
+        print(out)
+        return 0
+    from .viewer import run_viewer
+
+    keys = [k for k in args.keys.split(",") if k] if args.keys else []
+    return run_viewer(scene, technique, backend=args.backend, frames=args.frames, screenshot=args.screenshot, keys=keys)
+
+
+def cmd_techniques(args) -> int:
+    from .techniques import TECHNIQUES
+
+    for t in TECHNIQUES.values():
+        print(f"{t.key}  {t.name:<10} needs: {', '.join(t.textures):<22} cost: {t.cost}")
+        print(f"   {t.description}")
+        for p in t.params:
+            kind = p.kind.__name__
+            rng = "" if p.kind is bool else f" [{p.min:g}..{p.max:g}]"
+            print(f"   - {p.name} ({kind}, default {p.default}{rng}): {p.doc}")
+    return 0
+
+
+def cmd_info(args) -> int:
+    from .gpu import describe_adapters
+
+    print(describe_adapters(args.backend))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="wgpuviewer", description="Relief-mapping techniques on WebGPU: viewer, offscreen renderer, probe."
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    backend_help = f"wgpu backend (default: ${BACKEND_ENV} or auto: hardware first, then software)"
+
+    view = sub.add_parser("view", help="open the interactive viewer (renders a PNG when there is no display)")
+    view.add_argument("scene", nargs="?", help="scene TOML (default: the built-in default scene)")
+    view.add_argument("--technique", help="technique to start with (default: the scene's)")
+    view.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    view.add_argument("--frames", type=int, help="scripted run: draw this many frames, then exit")
+    view.add_argument("--screenshot", help="scripted run: save the last frame to this PNG")
+    view.add_argument("--keys", help="scripted run: comma-separated keys to press, one per frame (e.g. 2,3,ArrowRight)")
+    view.set_defaults(func=cmd_view)
+
+    render = sub.add_parser("render", help="render a scene offscreen to PNG or .npy")
+    render.add_argument("scene", nargs="?", help="scene TOML (default: the built-in default scene)")
+    render.add_argument("-o", "--output", required=True, help="output file: .png (picture) or .npy (raw float32)")
+    render.add_argument("--technique", help="technique (default: the scene's)")
+    render.add_argument("--size", help=f"WIDTHxHEIGHT (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
+    render.add_argument("--mode", choices=("color", "uv", "depth", "cost"), default="color", help="what to write")
+    render.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    render.set_defaults(func=cmd_render)
+
+    techniques = sub.add_parser("techniques", help="list techniques, their keys, needed maps and parameters")
+    techniques.set_defaults(func=cmd_techniques)
+
+    info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
+    info.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    info.set_defaults(func=cmd_info)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        args = parser.parse_args(["view", *(argv or [])])
+    try:
+        return args.func(args)
+    except UserError as error:
+        print(f"wgpuviewer: error: {error}", file=sys.stderr)
+        return error.exit_code
+    except KeyboardInterrupt:
+        return 130

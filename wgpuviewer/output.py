@@ -1,0 +1,91 @@
+"""Turning an offscreen render into what a mode asks for, and writing files atomically."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from .errors import UserError
+from .renderer import OffscreenImage
+
+OUTPUT_MODES = ("color", "uv", "depth", "cost")
+OUTPUT_SUFFIXES = (".png", ".npy")
+
+
+def mode_data(image: OffscreenImage, mode: str) -> np.ndarray:
+    """Raw float32 data of a mode; NaN where nothing was drawn (except colour, which shows the background).
+
+    color: (H, W, 3) the sRGB image in [0, 1]; uv: (H, W, 2) hit UV (not wrapped);
+    depth: (H, W) hit layer depth t; cost: (H, W) depth fetches per pixel.
+    """
+    if mode == "color":
+        return image.color[:, :, :3].astype(np.float32) / 255.0
+    covered = image.covered
+    d = image.data
+    if mode == "uv":
+        out = d[:, :, 0:2].copy()
+    elif mode == "depth":
+        out = d[:, :, 2].copy()
+    else:
+        fetches = d[:, :, 3]
+        out = np.where(fetches < 0, -fetches - 1.0, fetches).astype(np.float32)  # capped rays are stored negative
+    out[~covered] = np.nan
+    return out
+
+
+def mode_picture(image: OffscreenImage, mode: str) -> np.ndarray:
+    """(H, W, 3) uint8 RGB picture of a mode."""
+    if mode == "color":
+        return image.color[:, :, :3].copy()
+    data = mode_data(image, mode)
+    covered = image.covered
+    if mode == "uv":
+        rgb = np.zeros(data.shape[:2] + (3,), np.float32)
+        rgb[:, :, :2] = np.nan_to_num(data - np.floor(data))
+        return np.rint(rgb * 255).astype(np.uint8)
+    values = np.nan_to_num(data)
+    if mode == "cost":
+        peak = max(float(values.max()), 1.0)
+        values = values / peak
+    grey = np.clip(np.rint(values * 255), 0, 255).astype(np.uint8)
+    if mode == "cost":
+        rgb = cv2.cvtColor(cv2.applyColorMap(grey, cv2.COLORMAP_INFERNO), cv2.COLOR_BGR2RGB)
+    else:
+        rgb = np.repeat(grey[:, :, None], 3, axis=2)
+    rgb[~covered] = 0
+    return rgb
+
+
+def write_atomic(path: Path, write) -> None:
+    """Call ``write(tmp_path)`` and move the result into place: readers never see a partial file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def save_rgb_png(path: Path, rgb: np.ndarray) -> None:
+    def write(tmp: Path):
+        if not cv2.imwrite(str(tmp), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
+            raise UserError(f"{path}: could not write PNG")
+
+    write_atomic(path, write)
+
+
+def save_output(path: Path, image: OffscreenImage, mode: str) -> None:
+    path = Path(path)
+    if path.suffix.lower() == ".npy":
+        data = mode_data(image, mode)
+        write_atomic(path, lambda tmp: np.save(tmp, data))
+    else:
+        save_rgb_png(path, mode_picture(image, mode))
