@@ -1,0 +1,64 @@
+"""Map generation for relief mapping: normal, complexity and maximum-pyramid maps from height maps.
+
+Each kind has a WGSL compute kernel (``wgpuviewer.wgsl.maps``), a CPU implementation (OpenCV/numpy) that is
+both the fallback and the cross-check, and an entry in :data:`maptools.registry.KINDS`.
+
+Conventions: heights are float32 (H, W) in [0, 1], 1 = top; columns are u (x, right), rows are v with
+row 0 = v near 0 (v increases with the row index).
+"""
+
+from __future__ import annotations
+
+import sys
+
+from wgpuviewer.errors import NoAdapterError, UserError
+
+from .io import load_height_input, validate_height
+
+__all__ = ["generate", "load_height_input", "validate_height", "resolve_backend", "VERSION", "KINDS"]
+
+#: Version of the map algorithms; part of every cache key (bump when an output changes).
+VERSION = "maptools-1"
+
+_notice_printed = False
+
+
+def resolve_backend(backend: str = "auto") -> str:
+    """'auto' -> 'gpu' when an adapter exists, else 'cpu' (one-line notice on stderr); 'gpu' / 'cpu' as given."""
+    global _notice_printed
+    if backend not in ("auto", "gpu", "cpu"):
+        raise UserError(f"--backend {backend!r}: expected auto, gpu or cpu")
+    if backend != "auto":
+        return backend
+    from . import gpu
+
+    try:
+        gpu.runner()
+        return "gpu"
+    except NoAdapterError:
+        if not _notice_printed:
+            print("notice: maptools: no GPU adapter; using the CPU implementation", file=sys.stderr)
+            _notice_printed = True
+        return "cpu"
+
+
+def generate(kind: str, height, backend: str = "auto", **options):
+    """Generate map ``kind`` from ``height`` (float (H, W) in [0, 1]) on ``backend`` (auto, gpu, cpu).
+
+    normal -> float32 (H, W, 3); complexity -> uint8 (H, W); maxmip -> list of float32 arrays (level 0 first).
+    """
+    from .registry import get_kind
+
+    k = get_kind(kind)
+    opts = k.resolve(options)
+    h = validate_height(height)
+    fn = k.gpu if resolve_backend(backend) == "gpu" else k.cpu
+    return fn(h, **opts)
+
+
+def __getattr__(name):
+    if name == "KINDS":
+        from .registry import KINDS
+
+        return KINDS
+    raise AttributeError(name)

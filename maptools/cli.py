@@ -1,0 +1,316 @@
+"""``maptools`` command line: generate one map, batch-generate many, or check GPU against CPU.
+
+Exit codes: 0 success, 1 a batch job or a check failed, 2 a user error (one line on stderr).
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import sys
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+from wgpuviewer.errors import UserError
+
+from . import VERSION, generate, load_height_input, resolve_backend
+from .io import CHANNELS, INPUT_EXTS, NAN_POLICIES, atomic_open, write_result
+from .registry import KINDS, get_kind
+
+
+def _flag(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def _add_input_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--channel", default="auto", choices=CHANNELS,
+                   help="channel of a colour input (auto: grey, or a colour image with equal channels)")
+    p.add_argument("--nan-policy", default="error", choices=NAN_POLICIES,
+                   help="NaN/inf texels: error (refuse), zero, nearest (nearest finite texel)")
+
+
+def _add_backend(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--backend", default="auto", choices=("auto", "gpu", "cpu"),
+                   help="auto: GPU when an adapter exists, else CPU")
+
+
+def _parse_kinds(text: str | None) -> list[str]:
+    if not text:
+        return list(KINDS)
+    names = [t.strip() for t in text.split(",") if t.strip()]
+    for n in names:
+        get_kind(n)
+    return list(dict.fromkeys(names))
+
+
+def _parse_sets(items: list[str] | None) -> dict[str, dict]:
+    """--set KIND.OPTION=VALUE (repeatable) -> {kind: {option: value}}."""
+    out: dict[str, dict] = {}
+    for item in items or []:
+        head, eq, value = item.partition("=")
+        kind, dot, opt = head.partition(".")
+        if not eq or not dot:
+            raise UserError(f"--set {item!r}: expected KIND.OPTION=VALUE, e.g. complexity.levels=16")
+        get_kind(kind)
+        out.setdefault(kind, {})[opt.replace("-", "_")] = value
+    return out
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="maptools", description="Generate maps derived from height maps.")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    gen = sub.add_parser("generate", help="generate one map from one height map")
+    gen_kinds = gen.add_subparsers(dest="kind", required=True, metavar="KIND")
+    for kind in KINDS.values():
+        kp = gen_kinds.add_parser(kind.name, help=kind.description, description=kind.description)
+        kp.add_argument("input", metavar="INPUT", help="height map: .png (8/16-bit) or float .npy")
+        kp.add_argument("-o", "--output", required=True, metavar="OUT",
+                        help=f"output file ({', '.join(kind.extensions)})")
+        _add_backend(kp)
+        _add_input_options(kp)
+        kp.add_argument("--bits", type=int, default=8, choices=(8, 16), help="PNG bit depth")
+        for opt in kind.options:
+            kp.add_argument(_flag(opt.name), dest=f"opt_{opt.name}", default=None, metavar=opt.name.upper(),
+                            choices=opt.choices and [str(c) for c in opt.choices],
+                            help=f"{opt.help} (default {opt.default})")
+
+    bat = sub.add_parser("batch", help="generate maps for many height maps (files and folders)")
+    bat.add_argument("inputs", nargs="+", metavar="INPUT")
+    bat.add_argument("-o", "--output", required=True, metavar="DIR")
+    bat.add_argument("--kinds", default=None, help=f"comma-separated kinds (default all: {','.join(KINDS)})")
+    bat.add_argument("--jobs", type=int, default=1, help="worker threads (GPU work is serialised)")
+    bat.add_argument("--shard", default=None, metavar="I/N", help="process only sorted inputs i with i %% N == I")
+    bat.add_argument("--force", action="store_true", help="regenerate even when outputs are up to date")
+    bat.add_argument("--set", action="append", metavar="KIND.OPTION=VALUE", help="kind option (repeatable)")
+    bat.add_argument("--bits", type=int, default=8, choices=(8, 16), help="PNG bit depth")
+    _add_backend(bat)
+    _add_input_options(bat)
+
+    chk = sub.add_parser("check", help="run GPU and CPU paths and compare them against each kind's tolerance")
+    chk.add_argument("input", metavar="INPUT")
+    chk.add_argument("--kinds", default=None, help="comma-separated kinds (default all)")
+    chk.add_argument("--set", action="append", metavar="KIND.OPTION=VALUE", help="kind option (repeatable)")
+    _add_input_options(chk)
+
+    sub.add_parser("kinds", help="list the map kinds and their options")
+    return parser
+
+
+# -- generate ---------------------------------------------------------------------------------------
+
+def cmd_generate(args) -> int:
+    kind = get_kind(args.kind)
+    opts = {o.name: getattr(args, f"opt_{o.name}") for o in kind.options if getattr(args, f"opt_{o.name}") is not None}
+    opts = kind.resolve(opts)
+    out = Path(args.output)
+    if out.suffix.lower() not in kind.extensions:
+        raise UserError(f"{out}: {kind.name} maps are written as {', '.join(kind.extensions)}")
+    height = load_height_input(args.input, args.channel, args.nan_policy)
+    result = generate(kind.name, height, backend=args.backend, **opts)
+    write_result(kind, result, out, args.bits)
+    print(f"wrote {out}")
+    return 0
+
+
+# -- batch ------------------------------------------------------------------------------------------
+
+def collect_inputs(paths: list[str]) -> tuple[list[Path], list[tuple[str, str]]]:
+    """Sorted, de-duplicated input files (folders searched recursively for .png/.npy) and missing paths."""
+    files: set[Path] = set()
+    missing = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            files.update(f for f in p.rglob("*") if f.is_file() and f.suffix.lower() in INPUT_EXTS)
+        elif p.is_file():
+            files.add(p)
+        else:
+            missing.append((str(p), "no such file or folder"))
+    return sorted(files, key=str), missing
+
+
+def parse_shard(text: str | None) -> tuple[int, int]:
+    if text is None:
+        return 0, 1
+    try:
+        i, n = (int(x) for x in text.split("/"))
+    except ValueError:
+        raise UserError(f"--shard {text!r}: expected I/N, e.g. 0/4") from None
+    if n < 1 or not 0 <= i < n:
+        raise UserError(f"--shard {text!r}: need N >= 1 and 0 <= I < N")
+    return i, n
+
+
+def shard(items: list, i: int, n: int) -> list:
+    return [x for k, x in enumerate(items) if k % n == i]
+
+
+def job_key(digest: str, kind: str, opts: dict, args, ext: str) -> str:
+    blob = json.dumps({"input_sha256": digest, "kind": kind, "options": opts, "version": VERSION,
+                       "channel": args.channel, "nan_policy": args.nan_policy, "bits": args.bits, "ext": ext},
+                      sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+def sidecar(out: Path) -> Path:
+    return out.with_name(out.name + ".json")
+
+
+def up_to_date(out: Path, key: str) -> bool:
+    try:
+        return out.is_file() and json.loads(sidecar(out).read_text())["key"] == key
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+
+
+def cmd_batch(args) -> int:
+    kinds = _parse_kinds(args.kinds)
+    sets = _parse_sets(args.set)
+    kopts = {k: get_kind(k).resolve(sets.get(k, {})) for k in kinds}
+    si, sn = parse_shard(args.shard)
+    if args.jobs < 1:
+        raise UserError(f"--jobs {args.jobs}: must be >= 1")
+    files, missing = collect_inputs(args.inputs)
+    files = shard(files, si, sn)
+    outdir = Path(args.output)
+    if outdir.exists() and not outdir.is_dir():
+        raise UserError(f"-o {outdir}: exists and is not a folder")
+    outdir.mkdir(parents=True, exist_ok=True)
+    backend = resolve_backend(args.backend) if files else "cpu"
+
+    rows: list[tuple[str, str, str, str]] = [(p, "-", "FAILED", msg) for p, msg in missing]
+    claimed: dict[Path, Path] = {}  # output -> input (two inputs with one stem would overwrite each other)
+    plan = []
+    for f in files:
+        for k in kinds:
+            out = outdir / f"{f.stem}.{k}{get_kind(k).extensions[0]}"
+            if out in claimed:
+                rows.append((str(f), k, "FAILED", f"output {out.name} already produced from {claimed[out]}"))
+                continue
+            claimed[out] = f
+            plan.append((f, k, out))
+
+    by_input: dict[Path, list] = {}
+    for f, k, out in plan:
+        by_input.setdefault(f, []).append((k, out))
+    try:
+        from tqdm import tqdm
+        bar = tqdm(total=len(plan), unit="map", desc="maptools", file=sys.stderr, disable=None)
+    except ImportError:  # pragma: no cover - tqdm is a dependency
+        bar = None
+    lock = threading.Lock()
+
+    def run_input(f: Path) -> list:
+        res = []
+        try:
+            digest = hashlib.sha256(f.read_bytes()).hexdigest()
+        except OSError as exc:
+            return [(str(f), k, "FAILED", f"cannot read: {exc.strerror or exc}") for k, _ in by_input[f]]
+        height = None
+        for k, out in by_input[f]:
+            kind = get_kind(k)
+            key = job_key(digest, k, kopts[k], args, out.suffix.lower())
+            t0 = time.perf_counter()
+            try:
+                if not args.force and up_to_date(out, key):
+                    res.append((str(f), k, "skipped", "up to date"))
+                    continue
+                if height is None:
+                    height = load_height_input(f, args.channel, args.nan_policy)
+                result = generate(k, height, backend=backend, **kopts[k])
+                write_result(kind, result, out, args.bits)
+                with atomic_open(sidecar(out)) as fh:
+                    fh.write(json.dumps({"key": key, "input": str(f), "input_sha256": digest, "kind": k,
+                                         "options": kopts[k], "version": VERSION}, sort_keys=True).encode())
+                res.append((str(f), k, "ok", f"{out.name} ({time.perf_counter() - t0:.2f} s, {backend})"))
+            except UserError as exc:
+                res.append((str(f), k, "FAILED", str(exc)))
+            except Exception as exc:  # noqa: BLE001 - report, keep going with the other jobs
+                res.append((str(f), k, "FAILED", f"{type(exc).__name__}: {exc}"))
+            finally:
+                if bar is not None:
+                    with lock:
+                        bar.update(1)
+        return res
+
+    try:
+        if args.jobs == 1:
+            results = [run_input(f) for f in by_input]
+        else:
+            with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+                results = list(pool.map(run_input, list(by_input)))
+    finally:
+        if bar is not None:
+            bar.close()
+    for r in results:
+        rows.extend(r)
+
+    print_table(rows)
+    failed = sum(r[2] == "FAILED" for r in rows)
+    done = sum(r[2] == "ok" for r in rows)
+    skipped = sum(r[2] == "skipped" for r in rows)
+    print(f"{done} generated, {skipped} up to date, {failed} failed"
+          + (f" (shard {si}/{sn}: {len(files)} input(s))" if sn > 1 else ""))
+    return 1 if failed else 0
+
+
+def print_table(rows) -> None:
+    if not rows:
+        print("nothing to do")
+        return
+    head = ("input", "kind", "status", "detail")
+    widths = [max(len(head[c]), *(len(r[c]) for r in rows)) for c in range(3)]
+    fmt = "  ".join(f"{{:<{w}}}" for w in widths) + "  {}"
+    print(fmt.format(*head))
+    for r in rows:
+        print(fmt.format(*r))
+
+
+# -- check ------------------------------------------------------------------------------------------
+
+def cmd_check(args) -> int:
+    from . import gpu
+
+    kinds = _parse_kinds(args.kinds)
+    sets = _parse_sets(args.set)
+    height = load_height_input(args.input, args.channel, args.nan_policy)
+    g = gpu.runner()  # NoAdapterError (exit 2) when there is no GPU to check
+    print(f"{args.input}: {height.shape[1]}x{height.shape[0]} on {g.gpu.summary}")
+    bad = 0
+    for k in kinds:
+        kind = get_kind(k)
+        opts = kind.resolve(sets.get(k, {}))
+        c = kind.compare(kind.cpu(height, **opts), kind.gpu(height, **opts), opts)
+        bad += not c.ok
+        print(f"{k:<11} max {c.max_diff:.3g}  mean {c.mean_diff:.3g}  tolerance: {kind.tolerance}  "
+              f"{'OK' if c.ok else 'MISMATCH'}" + (f"  ({c.detail})" if c.detail else ""))
+    return 1 if bad else 0
+
+
+def cmd_kinds(args) -> int:
+    for kind in KINDS.values():
+        print(f"{kind.name}: {kind.description}")
+        print(f"  outputs: {', '.join(kind.extensions)}; GPU vs CPU: {kind.tolerance}")
+        for o in kind.options:
+            print(f"  {_flag(o.name)} (default {o.default}): {o.help}")
+    return 0
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse: usage errors (2) and --help (0)
+        return int(exc.code or 0)
+    try:
+        return {"generate": cmd_generate, "batch": cmd_batch, "check": cmd_check, "kinds": cmd_kinds}[args.command](args)
+    except UserError as exc:
+        print(f"maptools: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,191 @@
+"""GPU paths of the map kinds: drive the WGSL compute kernels in ``wgpuviewer.wgsl.maps``.
+
+Maps travel as row-major f32 storage buffers (exact texel values, no sampler or format conversion);
+results are read back with ``device.queue.read_buffer``. One lock serialises GPU work so that the
+batch tool's worker threads can share the single device.
+"""
+
+from __future__ import annotations
+
+import importlib.resources
+import threading
+
+import numpy as np
+import wgpu
+
+from wgpuviewer.errors import UserError
+from wgpuviewer.gpu import get_gpu
+
+from . import cpu
+
+_LOCK = threading.RLock()
+_WG = 8  # workgroup size (8x8) of every kernel
+
+
+class GpuKernelError(UserError):
+    """A kernel failed to compile, validate or run on this adapter."""
+
+
+def kernel_source(name: str) -> str:
+    files = importlib.resources.files("wgpuviewer.wgsl.maps")
+    return (files / "common.wgsl").read_text() + "\n" + (files / name).read_text()
+
+
+class MapGpu:
+    """Pipelines (compiled on first use) for one device."""
+
+    def __init__(self, gpu):
+        self.gpu = gpu
+        self.device: wgpu.GPUDevice = gpu.device
+        self._modules: dict[str, wgpu.GPUShaderModule] = {}
+        self._pipelines: dict[tuple[str, str], wgpu.GPUComputePipeline] = {}
+
+    def pipeline(self, file: str, entry: str) -> wgpu.GPUComputePipeline:
+        key = (file, entry)
+        if key not in self._pipelines:
+            try:
+                if file not in self._modules:
+                    self._modules[file] = self.device.create_shader_module(
+                        label=f"maptools {file}", code=kernel_source(file))
+                self._pipelines[key] = self.device.create_compute_pipeline(
+                    label=f"maptools {file}:{entry}", layout="auto",
+                    compute={"module": self._modules[file], "entry_point": entry})
+            except (wgpu.GPUValidationError, wgpu.GPUPipelineError) as exc:
+                raise GpuKernelError(f"GPU kernel {file}:{entry} failed to build on {self.gpu.summary}: "
+                                     f"{_first_line(exc)}; use --backend cpu") from None
+        return self._pipelines[key]
+
+    # -- resources ---------------------------------------------------------------------------------
+    def check_size(self, h: int, w: int, floats_per_texel: int = 1) -> None:
+        limits = self.device.limits
+        dim = limits["max-texture-dimension-2d"]
+        if h > dim or w > dim:
+            raise UserError(f"height map is {w}x{h}, larger than this adapter's max texture dimension {dim}; "
+                            f"downscale it or use --backend cpu")
+        need = h * w * 4 * floats_per_texel
+        cap = min(limits["max-storage-buffer-binding-size"], limits["max-buffer-size"])
+        if need > cap:
+            raise UserError(f"height map is {w}x{h}: {need} bytes exceed this adapter's storage buffer limit "
+                            f"{cap}; downscale it or use --backend cpu")
+
+    def storage(self, data_or_size, label: str) -> wgpu.GPUBuffer:
+        usage = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC | wgpu.BufferUsage.COPY_DST
+        if isinstance(data_or_size, int):
+            return self.device.create_buffer(label=label, size=max(4, data_or_size), usage=usage)
+        return self.device.create_buffer_with_data(label=label, data=data_or_size, usage=usage)
+
+    def uniform(self, words: list, label: str) -> wgpu.GPUBuffer:
+        """Uniform buffer from a list of ints (u32) and floats (f32), padded to 16-byte multiples."""
+        arr = np.zeros(((len(words) + 3) // 4) * 4, np.uint32)
+        for i, v in enumerate(words):
+            arr[i] = np.float32(v).view(np.uint32) if isinstance(v, float) else np.uint32(v)
+        return self.device.create_buffer_with_data(label=label, data=arr, usage=wgpu.BufferUsage.UNIFORM)
+
+    def dispatch(self, encoder, file: str, entry: str, bindings: dict, w: int, h: int) -> None:
+        pipe = self.pipeline(file, entry)
+        group = self.device.create_bind_group(
+            label=f"maptools {file}:{entry}", layout=pipe.get_bind_group_layout(0),
+            entries=[{"binding": b, "resource": {"buffer": buf}} for b, buf in bindings.items()])
+        cp = encoder.begin_compute_pass(label=f"maptools {file}:{entry}")
+        cp.set_pipeline(pipe)
+        cp.set_bind_group(0, group)
+        cp.dispatch_workgroups((w + _WG - 1) // _WG, (h + _WG - 1) // _WG, 1)
+        cp.end()
+
+    def submit(self, encoder, what: str) -> None:
+        try:
+            self.device.queue.submit([encoder.finish()])
+        except wgpu.GPUValidationError as exc:
+            raise GpuKernelError(f"GPU {what} failed validation on {self.gpu.summary}: {_first_line(exc)}; "
+                                 f"use --backend cpu") from None
+
+    def read(self, buf: wgpu.GPUBuffer, count: int) -> np.ndarray:
+        return np.frombuffer(self.device.queue.read_buffer(buf, 0, count * 4), np.float32).copy()
+
+    def encoder(self, label: str):
+        return self.device.create_command_encoder(label=label)
+
+
+def _first_line(exc: Exception) -> str:
+    text = str(exc).strip().splitlines()
+    return next((t.strip() for t in text if t.strip()), type(exc).__name__)
+
+
+_runners: dict[int, MapGpu] = {}
+
+
+def runner(backend: str | None = None) -> MapGpu:
+    gpu = get_gpu(None if backend in (None, "gpu") else backend)
+    key = id(gpu.device)
+    if key not in _runners:
+        _runners[key] = MapGpu(gpu)
+    return _runners[key]
+
+
+def _guard(fn):
+    def wrapped(height, **options):
+        with _LOCK:
+            try:
+                return fn(runner(), np.ascontiguousarray(height, np.float32), **options)
+            except (wgpu.GPUValidationError, wgpu.GPUPipelineError) as exc:
+                raise GpuKernelError(f"GPU {fn.__name__} kernel failed: {_first_line(exc)}; use --backend cpu") from None
+    wrapped.__name__ = fn.__name__
+    wrapped.__doc__ = fn.__doc__
+    return wrapped
+
+
+@_guard
+def normal(g: MapGpu, height: np.ndarray, *, strength: float = 1.0, y: str = "opengl", border: str = "repeat"):
+    """GPU twin of cpu.normal (normal.wgsl)."""
+    h, w = height.shape
+    g.check_size(h, w, 3)
+    src = g.storage(height, "maptools normal src")
+    dst = g.storage(h * w * 12, "maptools normal dst")
+    params = g.uniform([w, h, cpu.BORDER_CODE[border], 0, float(strength), 1.0 if y == "opengl" else -1.0],
+                       "maptools normal params")
+    enc = g.encoder("maptools normal")
+    g.dispatch(enc, "normal.wgsl", "main", {0: params, 1: src, 2: dst}, w, h)
+    g.submit(enc, "normal")
+    return g.read(dst, h * w * 3).reshape(h, w, 3)
+
+
+@_guard
+def complexity(g: MapGpu, height: np.ndarray, *, ksize: int = 3, dilate_kernel: int = 3, iterations: int = 5,
+               gamma: float = 0.8, levels: int = 24, border: str = "reflect"):
+    """GPU twin of cpu.complexity (complexity.wgsl: sobel_mag, dilate_h, dilate_v_finish)."""
+    h, w = height.shape
+    g.check_size(h, w)
+    src = g.storage(height, "maptools complexity src")
+    mag = g.storage(h * w * 4, "maptools complexity magnitude")
+    tmp = g.storage(h * w * 4, "maptools complexity dilated rows")
+    out = g.storage(h * w * 4, "maptools complexity out")
+    maxbits = g.storage(np.zeros(4, np.uint32), "maptools complexity max")
+    step = float(np.float32(1.0 / (levels - 1)))
+    params = g.uniform([w, h, cpu.BORDER_CODE[border], ksize, cpu.dilation_radius(dilate_kernel, iterations),
+                        1 if border == "repeat" else 0, levels, 0, float(gamma), step],
+                       "maptools complexity params")
+    enc = g.encoder("maptools complexity")
+    g.dispatch(enc, "complexity.wgsl", "sobel_mag", {0: params, 1: src, 2: mag, 3: maxbits}, w, h)
+    g.dispatch(enc, "complexity.wgsl", "dilate_h", {0: params, 1: mag, 2: tmp}, w, h)
+    g.dispatch(enc, "complexity.wgsl", "dilate_v_finish", {0: params, 1: tmp, 2: out, 3: maxbits}, w, h)
+    g.submit(enc, "complexity")
+    return g.read(out, h * w).reshape(h, w).astype(np.uint8)
+
+
+@_guard
+def maxmip(g: MapGpu, height: np.ndarray):
+    """GPU twin of cpu.maxmip (maxmip.wgsl, one dispatch per level)."""
+    sizes = cpu.level_sizes(*height.shape)
+    g.check_size(*height.shape)
+    bufs = [g.storage(height, "maptools maxmip level 0")]
+    enc = g.encoder("maptools maxmip")
+    for k, (ph, pw) in enumerate(sizes[1:], start=1):
+        sh, sw = sizes[k - 1]
+        bufs.append(g.storage(ph * pw * 4, f"maptools maxmip level {k}"))
+        params = g.uniform([sw, sh, pw, ph], f"maptools maxmip params {k}")
+        g.dispatch(enc, "maxmip.wgsl", "reduce", {0: params, 1: bufs[k - 1], 2: bufs[k]}, pw, ph)
+    g.submit(enc, "maxmip")
+    out = [height.copy()]
+    for k, (ph, pw) in enumerate(sizes[1:], start=1):
+        out.append(g.read(bufs[k], ph * pw).reshape(ph, pw))
+    return out

@@ -1,0 +1,163 @@
+"""The map kinds: one frozen entry per kind (options, CPU and GPU functions, cross-check tolerance, writer)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from wgpuviewer.errors import UserError
+
+from . import cpu, gpu, io
+
+
+@dataclass(frozen=True)
+class Option:
+    name: str
+    default: Any
+    type: type
+    help: str
+    choices: tuple | None = None
+    lo: float | None = None
+    hi: float | None = None
+
+    def validate(self, kind: str, value: Any) -> Any:
+        try:
+            v = self.type(value)
+            if self.type is int and isinstance(value, float) and not float(value).is_integer():
+                raise ValueError
+        except (TypeError, ValueError):
+            raise UserError(f"{kind}: option {self.name}={value!r} is not a valid {self.type.__name__}") from None
+        if self.type is float and not math.isfinite(v):
+            raise UserError(f"{kind}: option {self.name} must be finite, got {value!r}")
+        if self.choices is not None and v not in self.choices:
+            raise UserError(f"{kind}: option {self.name}={value!r}; expected one of {', '.join(map(str, self.choices))}")
+        if (self.lo is not None and v < self.lo) or (self.hi is not None and v > self.hi):
+            raise UserError(f"{kind}: option {self.name}={value!r} out of range [{self.lo}, {self.hi}]")
+        return v
+
+
+@dataclass(frozen=True)
+class Comparison:
+    max_diff: float
+    mean_diff: float
+    ok: bool
+    detail: str = ""
+
+
+@dataclass(frozen=True)
+class Kind:
+    name: str
+    description: str
+    options: tuple[Option, ...]
+    cpu: Callable
+    gpu: Callable
+    compare: Callable[[Any, Any, dict], Comparison]
+    tolerance: str
+    writer: Callable[[Any, Any, str, int], None]  # (file object, result, extension, bits)
+    extensions: tuple[str, ...]  # first = default for the batch tool
+    check: Callable[[dict], None] = field(default=lambda opts: None)
+
+    def resolve(self, options: dict) -> dict:
+        """Options with defaults filled in and validated; unknown names are a UserError."""
+        known = {o.name: o for o in self.options}
+        unknown = sorted(set(options) - set(known))
+        if unknown:
+            raise UserError(f"{self.name}: unknown option(s) {', '.join(unknown)}; "
+                            f"known: {', '.join(known) or 'none'}")
+        out = {o.name: o.validate(self.name, options.get(o.name, o.default)) for o in self.options}
+        self.check(out)
+        return out
+
+
+# -- comparisons ------------------------------------------------------------------------------------
+
+def _compare_normal(a, b, opts) -> Comparison:
+    d = np.abs(np.asarray(a, np.float64) - np.asarray(b, np.float64))
+    mx = float(d.max()) if d.size else 0.0
+    return Comparison(mx, float(d.mean()) if d.size else 0.0, mx <= NORMAL_TOL)
+
+
+def _compare_complexity(a, b, opts) -> Comparison:
+    d = np.abs(a.astype(np.int32) - b.astype(np.int32))
+    mx = int(d.max()) if d.size else 0
+    frac = float((d > 0).mean()) if d.size else 0.0
+    step = math.ceil(255 / (opts["levels"] - 1))
+    ok = mx <= step and frac <= COMPLEXITY_MAX_FLIPPED
+    return Comparison(float(mx), float(d.mean()) if d.size else 0.0, ok,
+                      f"{frac:.2e} of texels differ (allowed {COMPLEXITY_MAX_FLIPPED:g}, by at most one level = {step})")
+
+
+def _compare_maxmip(a, b, opts) -> Comparison:
+    if len(a) != len(b) or any(x.shape != y.shape for x, y in zip(a, b)):
+        return Comparison(math.inf, math.inf, False, "level count or shapes differ")
+    diffs = [np.abs(x.astype(np.float64) - y) for x, y in zip(a, b)]
+    mx = max(float(d.max()) for d in diffs)
+    mean = float(np.mean([d.mean() for d in diffs]))
+    return Comparison(mx, mean, mx == 0.0, f"{len(a)} levels")
+
+
+#: Normal components: float rounding of sqrt/division differs by a few ULP between GPU and numpy.
+NORMAL_TOL = 1e-5
+#: Complexity: sqrt, division and pow are not correctly rounded on every GPU; a difference of one ULP
+#: before quantisation can flip a texel to the neighbouring level. Allowed: one level, on <= 0.1 % of texels.
+COMPLEXITY_MAX_FLIPPED = 1e-3
+
+
+def _check_complexity(o: dict) -> None:
+    if o["levels"] < 2:
+        raise UserError(f"complexity: levels must be >= 2 (step = 1/(levels-1)), got {o['levels']}")
+    if o["dilate_kernel"] % 2 == 0:
+        raise UserError(f"complexity: dilate_kernel must be odd, got {o['dilate_kernel']}")
+    if cpu.dilation_radius(o["dilate_kernel"], o["iterations"]) > 1024:
+        raise UserError("complexity: dilation radius (dilate_kernel//2 * iterations) must be <= 1024")
+
+
+BORDER_HELP = "border handling: repeat (wrap, tiling textures), clamp, reflect (OpenCV's reflect-101)"
+
+KINDS: dict[str, Kind] = {
+    "normal": Kind(
+        name="normal",
+        description="unit tangent-space normals (H,W,3) from Sobel 3x3 gradients of the height map",
+        options=(
+            Option("strength", 1.0, float, "gradient scale: slope = strength * height units per texel", lo=0.0, hi=1e6),
+            Option("y", "opengl", str, "y convention: opengl (+y towards row 0, green up) or directx (+y = +v, "
+                   "increasing row)", choices=("opengl", "directx")),
+            Option("border", "repeat", str, BORDER_HELP, choices=cpu.BORDERS),
+        ),
+        cpu=cpu.normal, gpu=gpu.normal, compare=_compare_normal,
+        tolerance=f"max |component difference| <= {NORMAL_TOL:g}",
+        writer=io.write_normal, extensions=(".png", ".npy"),
+    ),
+    "complexity": Kind(
+        name="complexity",
+        description="thesis complexity map (Sobel magnitude, dilation, gamma, quantised levels), 8-bit",
+        options=(
+            Option("ksize", 3, int, "Sobel kernel size (listing 3; 5 also allowed)", choices=(3, 5)),
+            Option("dilate_kernel", 3, int, "dilation kernel size (listing 3, text 5)", lo=1, hi=99),
+            Option("iterations", 5, int, "dilation iterations (listing 5)", lo=0, hi=1024),
+            Option("gamma", 0.8, float, "gamma exponent (listing 0.8, text 0.9)", lo=1e-3, hi=100.0),
+            Option("levels", 24, int, "number of quantisation levels N >= 2 (listing 24)", lo=-(2**31), hi=4096),
+            Option("border", "reflect", str, BORDER_HELP + "; dilation wraps only with repeat", choices=cpu.BORDERS),
+        ),
+        cpu=cpu.complexity, gpu=gpu.complexity, compare=_compare_complexity,
+        tolerance=f"at most one quantisation level on <= {COMPLEXITY_MAX_FLIPPED:g} of texels (exact on lavapipe)",
+        writer=io.write_complexity, extensions=(".png", ".npy"), check=_check_complexity,
+    ),
+    "maxmip": Kind(
+        name="maxmip",
+        description="maximum pyramid: level 0 = height, each parent = max of the children it covers, down to 1x1",
+        options=(),
+        cpu=cpu.maxmip, gpu=gpu.maxmip, compare=_compare_maxmip,
+        tolerance="exact (max is exact)",
+        writer=io.write_maxmip, extensions=(".npz",),
+    ),
+}
+
+
+def get_kind(name: str) -> Kind:
+    if name not in KINDS:
+        raise UserError(f"unknown map kind {name!r}; expected one of {', '.join(KINDS)}")
+    return KINDS[name]

@@ -1,0 +1,43 @@
+// Normal map from a height map: Sobel 3x3 gradients, unit normals, three f32 per texel.
+// n = normalize(-s * dH/du, ysign * s * dH/drow, 1), dH/d* = Sobel / 8 (height units per texel).
+// ysign = +1 for the OpenGL convention (y towards row 0, "green up"), -1 for DirectX (y towards +row).
+
+struct Params {
+    width: u32,
+    height: u32,
+    border: u32,
+    _pad: u32,
+    strength: f32,
+    ysign: f32,
+    _pad2: vec2f,
+};
+
+@group(0) @binding(0) var<uniform> P: Params;
+@group(0) @binding(1) var<storage, read> src: array<f32>;
+@group(0) @binding(2) var<storage, read_write> dst: array<f32>;
+
+fn h(x: i32, y: i32) -> f32 {
+    let w = i32(P.width);
+    let hh = i32(P.height);
+    return src[border_index(y, hh, P.border) * w + border_index(x, w, P.border)];
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    if (gid.x >= P.width || gid.y >= P.height) { return; }
+    let x = i32(gid.x);
+    let y = i32(gid.y);
+    // Same grouping as OpenCV's separable Sobel: centre*2 + (side + side).
+    let dm = h(x + 1, y - 1) - h(x - 1, y - 1);
+    let d0 = h(x + 1, y) - h(x - 1, y);
+    let dp = h(x + 1, y + 1) - h(x - 1, y + 1);
+    let gx = d0 * 2.0 + (dm + dp);
+    let sm = h(x, y - 1) * 2.0 + (h(x - 1, y - 1) + h(x + 1, y - 1));
+    let sp = h(x, y + 1) * 2.0 + (h(x - 1, y + 1) + h(x + 1, y + 1));
+    let gy = sp - sm;
+    let n = normalize(vec3f(-P.strength * gx * 0.125, P.ysign * P.strength * gy * 0.125, 1.0));
+    let i = (gid.y * P.width + gid.x) * 3u;
+    dst[i] = n.x;
+    dst[i + 1u] = n.y;
+    dst[i + 2u] = n.z;
+}
