@@ -1,0 +1,57 @@
+"""Probe-against-reference measurements: UV error in texels, fetches per ray, capped fraction.
+
+Used by the tests, ``wgpuviewer accuracy`` and (later) the benchmark, so every number about a
+technique's error is computed one way.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .probe import probe
+from .reference import exact_hit, uv_error_texels, view_dir_from_angles
+
+
+@dataclass
+class Accuracy:
+    technique: str
+    angle: float
+    params: dict
+    error_mean: float  # texels, over rays that were not capped
+    error_p95: float
+    error_max: float
+    fetches_mean: float
+    fetches_p95: float
+    capped: float  # fraction of rays flagged capped
+    rays: int
+
+
+def random_rays(n: int, angle_deg: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` entry points uniform over the texture, view directions at ``angle_deg`` from the normal
+    with uniformly random azimuth."""
+    rng = np.random.default_rng(seed)
+    uv = rng.random((n, 2))
+    view = view_dir_from_angles(np.full(n, angle_deg), rng.random(n) * 360.0)
+    return uv, view
+
+
+def measure(
+    technique: str, height: np.ndarray, angle_deg: float, height_scale: float = 0.05,
+    rays: int = 4096, seed: int = 0, backend: str | None = None, **params,
+) -> Accuracy:
+    """Trace ``rays`` random rays at ``angle_deg`` with the GPU probe and the float64 reference."""
+    height = np.asarray(height, np.float64)
+    uv, view = random_rays(rays, angle_deg, seed)
+    got = probe(technique, height, uv, view, height_scale, backend=backend, **params)
+    ref = exact_hit(1.0 - height, uv, view, height_scale)
+    ok = ~got.capped & ref.valid
+    err = uv_error_texels(got.uv[ok], ref.uv[ok], height.shape[::-1]) if ok.any() else np.array([np.nan])
+    fetches = got.fetches.astype(np.float64)
+    return Accuracy(
+        technique=technique, angle=angle_deg, params=params,
+        error_mean=float(np.mean(err)), error_p95=float(np.percentile(err, 95)), error_max=float(np.max(err)),
+        fetches_mean=float(fetches.mean()), fetches_p95=float(np.percentile(fetches, 95)),
+        capped=float(got.capped.mean()), rays=rays,
+    )
