@@ -115,13 +115,19 @@ class Renderer:
         return textures.load_depth(material.height, material.height_is_depth)
 
     def _normal_data(self, material) -> np.ndarray:
+        """Normals in the shader's tangent frame: x = u, y = v (image rows down)."""
         if material.normal is not None:
-            return textures.load_normal_map(material.normal, material.normal_y)
+            normals = textures.load_normal_map(material.normal, material.normal_y).copy()
+            normals[:, :, 1] *= -1  # OpenGL convention: +y points to image row 0, i.e. towards -v
+            return normals
         if material.height is None:
             return np.array([[[0.0, 0.0, 1.0]]], np.float32)
         height = 1.0 - textures.load_depth(material.height, material.height_is_depth)
         self.created.append(f"map:{material.name}.normal")
-        return cached_generate("normal", height, backend="cpu")
+        # Slopes of the actual relief: height_scale UV units deep over a texture width of 1 UV unit.
+        # maptools' "directx" convention has +y towards increasing rows, which is +v here.
+        strength = material.height_scale * height.shape[1]
+        return cached_generate("normal", height, backend="cpu", strength=strength, y="directx")
 
     def _material_layout(self, technique: Technique) -> wgpu.GPUBindGroupLayout:
         if technique.textures not in self._material_layouts:
