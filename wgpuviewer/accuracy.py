@@ -55,3 +55,31 @@ def measure(
         fetches_mean=float(fetches.mean()), fetches_p95=float(np.percentile(fetches, 95)),
         capped=float(got.capped.mean()), rays=rays,
     )
+
+
+DEFAULT_ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 89.0, 89.9)
+DEFAULT_SETTINGS = (
+    ("parallax", {}), ("parallax", {"offset_limiting": True}),
+    ("steep", {"layers": 32}), ("pom", {"layers": 8}), ("pom", {"layers": 32}), ("pom", {"layers": 256}),
+)
+
+
+def table(heightmaps: dict, angles=DEFAULT_ANGLES, settings=DEFAULT_SETTINGS, height_scale=0.05, rays=4096,
+          backend=None, progress=None) -> str:
+    """Markdown table of probe-vs-reference accuracy for each height map x setting x angle."""
+    lines = [
+        "| height map | technique | params | angle | UV err mean | p95 | max (texels) | fetches mean | p95 | capped |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for name, height in heightmaps.items():
+        for technique, params in settings:
+            for angle in angles:
+                a = measure(technique, height, angle, height_scale, rays, backend=backend, **params)
+                label = ", ".join(f"{k}={v}" for k, v in params.items()) or "-"
+                lines.append(
+                    f"| {name} | {technique} | {label} | {angle:g}° | {a.error_mean:.3f} | {a.error_p95:.3f} | "
+                    f"{a.error_max:.2f} | {a.fetches_mean:.1f} | {a.fetches_p95:.0f} | {a.capped:.1%} |"
+                )
+                if progress:
+                    progress()
+    return "\n".join(lines)

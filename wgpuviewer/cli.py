@@ -91,6 +91,28 @@ def cmd_techniques(args) -> int:
     return 0
 
 
+def cmd_accuracy(args) -> int:
+    from tqdm import tqdm
+
+    from .accuracy import DEFAULT_ANGLES, DEFAULT_SETTINGS, table
+    from .textures import BUILTINS, builtin_height
+
+    for name in args.heightmaps:
+        if name not in BUILTINS:
+            raise UserError(f"--heightmaps: unknown builtin {name!r}; expected some of {', '.join(BUILTINS)}")
+    maps = {name: builtin_height(name, (args.texels, args.texels)) for name in args.heightmaps}
+    total = len(maps) * len(DEFAULT_SETTINGS) * len(DEFAULT_ANGLES)
+    from .gpu import get_gpu
+
+    gpu = get_gpu(args.backend)
+    with tqdm(total=total, desc="probe vs reference", file=sys.stderr, leave=False) as bar:
+        text = table(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend, progress=bar.update)
+    print(f"Adapter: {gpu.summary}; height_scale {args.height_scale}; {args.rays} random rays per row; "
+          f"{args.texels}x{args.texels} maps; errors over rays that were not capped.\n")
+    print(text)
+    return 0
+
+
 def cmd_info(args) -> int:
     from .gpu import describe_adapters
 
@@ -125,6 +147,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     techniques = sub.add_parser("techniques", help="list techniques, their keys, needed maps and parameters")
     techniques.set_defaults(func=cmd_techniques)
+
+    accuracy = sub.add_parser("accuracy", help="probe each ray-search technique against the float64 reference")
+    accuracy.add_argument("--heightmaps", nargs="+", default=["bricks", "bumps", "checker"], help="builtin maps")
+    accuracy.add_argument("--texels", type=int, default=256, help="map size (square)")
+    accuracy.add_argument("--rays", type=int, default=4096, help="random rays per row")
+    accuracy.add_argument("--height-scale", type=float, default=0.05, help="relief depth in UV units")
+    accuracy.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    accuracy.set_defaults(func=cmd_accuracy)
 
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
     info.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)

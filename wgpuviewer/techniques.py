@@ -107,7 +107,7 @@ TECHNIQUES: dict[str, Technique] = {
             "pom", "5",
             "Parallax occlusion mapping: steep parallax, then linear interpolation between the last two "
             "layers (guarded against a zero denominator).",
-            "up to N+2 depth fetches", ("albedo", "normal", "depth"),
+            "up to N+1 depth fetches", ("albedo", "normal", "depth"),
             (Param("layers", 16, 1, MAX_LAYERS, int, _LAYERS_DOC),),
             ray_search=True,
         ),

@@ -1,0 +1,105 @@
+"""CLI behaviour: outputs, exit codes (0 ok, 2 user error, one line, no traceback)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from wgpuviewer.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def run_cli(*args, env=None, cwd=None):
+    return subprocess.run(
+        [sys.executable, "-m", "wgpuviewer", *args], capture_output=True, text=True, timeout=300,
+        env={**os.environ, **(env or {})}, cwd=cwd,
+    )
+
+
+def assert_user_error(result, *fragments):
+    assert result.returncode == 2, result.stderr
+    lines = [line for line in result.stderr.splitlines() if line.startswith("wgpuviewer: error:")]
+    assert len(lines) == 1, result.stderr
+    assert "Traceback" not in result.stderr
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+def test_render_png_and_npy(tmp_path, adapter):
+    png, npy = tmp_path / "out" / "a.png", tmp_path / "a.npy"
+    assert main(["render", "-o", str(png), "--technique", "pom", "--size", "80x48"]) == 0
+    picture = cv2.imread(str(png))
+    assert picture.shape == (48, 80, 3)
+    assert main(["render", "-o", str(npy), "--size", "80x48", "--mode", "uv"]) == 0
+    data = np.load(npy)
+    assert data.shape == (48, 80, 2) and data.dtype == np.float32
+    assert not list(tmp_path.glob("**/.*"))  # no temp files left behind
+
+
+def test_render_is_byte_identical_across_runs(tmp_path, adapter):
+    a, b = tmp_path / "a.png", tmp_path / "b.png"
+    for out in (a, b):
+        assert run_cli("render", str(ROOT / "scenes" / "default.toml"), "-o", str(out), "--size", "64x40").returncode == 0
+    assert a.read_bytes() == b.read_bytes()
+
+
+@pytest.mark.parametrize(
+    "args,fragments",
+    [
+        (["render", "-o", "x.png", "--technique", "nope"], ["--technique", "'nope'", "unknown technique"]),
+        (["render", "-o", "x.png", "--size", "big"], ["--size", "'big'", "WIDTHxHEIGHT"]),
+        (["render", "-o", "x.png", "--size", "0x10"], ["--size", "'0x10'"]),
+        (["render", "-o", "x.jpg"], ["x.jpg", ".png", ".npy"]),
+        (["render", "missing.toml", "-o", "x.png"], ["missing.toml"]),
+        (["view", "missing.toml"], ["missing.toml"]),
+    ],
+)
+def test_user_errors_exit_2_with_one_line(tmp_path, args, fragments):
+    assert_user_error(run_cli(*args, cwd=tmp_path), *fragments)
+
+
+def test_bad_scene_value_names_file_key_and_value(tmp_path):
+    scene = tmp_path / "bad.toml"
+    scene.write_text((ROOT / "scenes" / "default.toml").read_text().replace("fov = 55.0", "fov = 500.0"))
+    assert_user_error(run_cli("render", str(scene), "-o", str(tmp_path / "x.png")), "bad.toml", "camera.fov", "500")
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_backend_without_adapter_exits_2_with_the_fix(tmp_path):
+    backend = "dx12" if sys.platform != "win32" else "metal"
+    result = run_cli("render", "-o", str(tmp_path / "x.png"), "--backend", backend)
+    assert_user_error(result, "no GPU adapter", backend)
+
+
+def test_backend_environment_variable_is_validated(tmp_path):
+    result = run_cli("info", env={"WGPUVIEWER_BACKEND": "vulcan"})
+    assert_user_error(result, "WGPUVIEWER_BACKEND", "vulcan", "vulkan")
+
+
+def test_info_and_techniques(adapter, capsys):
+    assert main(["info"]) == 0
+    out = capsys.readouterr().out
+    assert "chosen (auto):" in out and "relevant features:" in out
+    assert main(["techniques"]) == 0
+    out = capsys.readouterr().out
+    for name in ("basic", "normal", "parallax", "steep", "pom", "layers", "offset_limiting"):
+        assert name in out
+
+
+def test_view_without_display_renders_a_png(tmp_path, adapter):
+    env = {"DISPLAY": "", "WAYLAND_DISPLAY": ""}
+    result = run_cli("view", env=env, cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "no display" in result.stdout
+    out = tmp_path / "out" / "default_pom.png"
+    assert out.exists() and result.stdout.strip().endswith(str(Path("out") / "default_pom.png"))
+    # no arguments at all = view the default scene
+    result = run_cli(env=env, cwd=tmp_path)
+    assert result.returncode == 0 and "no display" in result.stdout
