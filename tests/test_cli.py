@@ -41,6 +41,7 @@ def test_render_png_and_npy(tmp_path, adapter):
     data = np.load(npy)
     assert data.shape == (48, 80, 2) and data.dtype == np.float32
     assert not list(tmp_path.glob("**/.*"))  # no temp files left behind
+    assert png.stat().st_mode & 0o044  # readable by others, like any file the user writes
 
 
 def test_render_is_byte_identical_across_runs(tmp_path, adapter):

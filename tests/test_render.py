@@ -99,7 +99,7 @@ def test_only_what_the_scene_needs(gpu):
     assert renderer.created == []  # nothing before the first frame
     renderer.render("normal", (64, 64))
     assert not [c for c in renderer.created if c.endswith(".depth")]
-    assert [c for c in renderer.created if c.startswith("pipeline:")] == ["pipeline:normal:rgba8unorm-srgb+rgba32float"]
+    assert [c for c in renderer.created if c.startswith("pipeline:")] == ["pipeline:normal:rgba8unorm-srgb+rgba32uint"]
     textures = sorted(c for c in renderer.created if c.startswith("texture:"))
     assert textures == ["texture:bricks.albedo", "texture:bricks.normal"]
 
@@ -115,7 +115,7 @@ def test_resources_follow_the_selected_technique(gpu):
     renderer.render("steep", (32, 32))
     assert renderer.created[: len(before)] == before
     new = renderer.created[len(before) :]
-    assert new == ["pipeline:steep:rgba8unorm-srgb+rgba32float"]  # steep reuses every texture
+    assert new == ["pipeline:steep:rgba8unorm-srgb+rgba32uint"]  # steep reuses every texture
 
 
 def test_grazing_camera_renders_finite(gpu):
@@ -128,3 +128,17 @@ def test_grazing_camera_renders_finite(gpu):
     for technique in ("parallax", "steep", "pom"):
         image = renderer.render(technique, (96, 64), camera)
         assert np.isfinite(image.data).all()
+
+
+def test_opengl_backend_draws_the_same_picture(adapter):
+    """The OpenGL backend (no float32 filtering, no float32 render targets) matches the default one."""
+    from wgpuviewer.gpu import BACKENDS, get_gpu, list_adapters
+
+    if not any(a.info.get("backend_type") == BACKENDS["gl"] for a in list_adapters()):
+        pytest.skip("no OpenGL adapter")
+    scene = load_scene(default_scene_path())
+    gl = Renderer(scene, get_gpu("gl", quiet=True)).render("pom", (160, 90))
+    default = Renderer(scene, get_gpu("auto", quiet=True)).render("pom", (160, 90))
+    diff = np.abs(gl.color.astype(np.int16) - default.color.astype(np.int16))
+    assert diff.mean() < 0.5 and (diff.max(axis=2) > 16).mean() < 0.002
+    assert np.isfinite(gl.data[gl.covered]).all()

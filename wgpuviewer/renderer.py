@@ -23,7 +23,7 @@ from .techniques import Technique, get_technique
 
 MAX_LIGHTS = 4  # mirrors render.wgsl
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
-DATA_FORMAT = "rgba32float"  # offscreen raw trace data: hit u, v, depth, fetches
+DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, depth, fetches
 DEPTH_FORMAT = "depth32float"
 FRAME_SIZE = 64 + 16 + 16 + MAX_LIGHTS * 32
 OBJECT_SIZE = 64 + 64 + 16
@@ -282,7 +282,9 @@ class Renderer:
             (COLOR_FORMAT, DATA_FORMAT), technique_name, camera or self.scene.camera, size,
         )
         device.queue.submit([encoder.finish()])
-        return OffscreenImage(color=_read_texture(device, color, 4, np.uint8), data=_read_texture(device, data, 4, np.float32))
+        return OffscreenImage(
+            color=_read_texture(device, color, 4, np.uint8), data=_read_texture(device, data, 4, np.uint32).view(np.float32)
+        )
 
 
 def _read_texture(device, texture, channels: int, dtype) -> np.ndarray:

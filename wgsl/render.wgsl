@@ -128,7 +128,9 @@ fn fs_color(in: VertexOut) -> @location(0) vec4f {
 
 struct DataOut {
     @location(0) color: vec4f,
-    @location(1) data: vec4f,  // hit u, hit v, hit depth, fetches; capped rays get negative fetches
+    // hit u, hit v, hit depth, fetches (negative: capped), as float bits: float32 targets are not
+    // renderable everywhere (OpenGL ES), 32-bit integer targets are.
+    @location(1) data: vec4u,
 }
 
 // Offscreen output: the shaded colour plus the raw trace data (uv/depth/cost modes, .npy files).
@@ -136,5 +138,6 @@ struct DataOut {
 fn fs_data(in: VertexOut) -> DataOut {
     let s = shade(in);
     let fetches = f32(s.hit.fetches);
-    return DataOut(vec4f(s.color, 1.0), vec4f(s.hit.uv, s.hit.depth, select(fetches, -fetches - 1.0, s.hit.capped)));
+    let data = vec4f(s.hit.uv, s.hit.depth, select(fetches, -fetches - 1.0, s.hit.capped));
+    return DataOut(vec4f(s.color, 1.0), bitcast<vec4u>(data));
 }
