@@ -12,7 +12,8 @@ import numpy as np
 import wgpu
 
 from .errors import UserError
-from .gpu import Gpu, create_texture, get_gpu
+from .gpu import Gpu, get_gpu
+from .maps import MAP_SLOTS, layout_entries
 from .shaders import compose, pack_trace_params
 from .techniques import TECHNIQUES, get_technique, resolve_params
 
@@ -49,7 +50,7 @@ def _pipeline(gpu: Gpu, technique_name: str) -> tuple[wgpu.GPUComputePipeline, l
             entries=[
                 {"binding": 0, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.uniform}},
                 {"binding": 1, "visibility": C, "sampler": {"type": wgpu.SamplerBindingType.filtering}},
-                {"binding": 4, "visibility": C, "texture": {"sample_type": wgpu.TextureSampleType.float}},
+                *layout_entries(technique.textures, C),
             ],
         )
         layout = device.create_pipeline_layout(label="probe", bind_group_layouts=[io_layout, material_layout])
@@ -73,7 +74,8 @@ def probe(
 ) -> ProbeResult:
     """Trace rays with ``technique`` on the GPU.
 
-    height: (H, W) height map in [0, 1] (1 = top; the GPU gets depth = 1 - height).
+    height: (H, W) height map in [0, 1] (1 = top; the GPU gets depth = 1 - height). The maps the
+    technique needs are built from it (cached by maptools), exactly as the renderer builds them.
     uv: (N, 2) entry points; view_dir: (N, 3) or (3,) tangent-space V (towards the eye).
     params: technique parameters (e.g. ``layers=64``), validated against the registry.
     """
@@ -110,7 +112,8 @@ def probe(
     params_buf = device.create_buffer_with_data(
         label="probe:params", data=pack_trace_params(height_scale, height.shape, values), usage=S.UNIFORM
     )
-    depth_tex = create_texture(gpu, [1.0 - height], gpu.depth_format, "probe:depth")
+    depth = 1.0 - height
+    maps = [(MAP_SLOTS[n], MAP_SLOTS[n].build(gpu, depth, height_scale, f"probe:{n}")) for n in tech.textures if n in MAP_SLOTS]
     mode = wgpu.AddressMode.repeat if address == "repeat" else wgpu.AddressMode.clamp_to_edge
     sampler = device.create_sampler(
         label="probe:sampler", address_mode_u=mode, address_mode_v=mode, mag_filter="linear", min_filter="linear"
@@ -127,7 +130,7 @@ def probe(
         entries=[
             {"binding": 0, "resource": {"buffer": params_buf}},
             {"binding": 1, "resource": sampler},
-            {"binding": 4, "resource": depth_tex.create_view()},
+            *({"binding": slot.binding, "resource": texture.create_view()} for slot, texture in maps),
         ],
     )
     groups = -(-n // _WORKGROUP)

@@ -17,6 +17,7 @@ from maptools.cache import cached_generate
 from . import camera as cam
 from . import meshes, textures
 from .gpu import Gpu, create_texture, mip_chain
+from .maps import MAP_SLOTS, layout_entries
 from .scene import Camera, Scene
 from .shaders import compose, pack_trace_params, trace_params_size
 from .techniques import Technique, get_technique
@@ -31,8 +32,12 @@ OBJECT_SIZE = 64 + 64 + 16
 #: Frame.mode values (render.wgsl).
 MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3}
 
-_TEXTURE_BINDINGS = {"albedo": 2, "normal": 3, "depth": 4}
+_TEXTURE_BINDINGS = {"albedo": 2, "normal": 3}  # height-derived ones: maps.MAP_SLOTS
 _TEXTURE_FORMATS = {"albedo": "rgba16float", "normal": "rgba8unorm"}
+
+
+def _binding(texture_name: str) -> int:
+    return MAP_SLOTS[texture_name].binding if texture_name in MAP_SLOTS else _TEXTURE_BINDINGS[texture_name]
 
 
 @dataclass
@@ -98,14 +103,17 @@ class Renderer:
         key = (material_name, kind)
         if key not in self._textures:
             material = self.scene.materials[material_name]
-            if kind == "depth":
-                data, fmt = self._depth_data(material), self.gpu.depth_format
-            elif kind == "normal":
-                data, fmt = self._normal_data(material) * 0.5 + 0.5, _TEXTURE_FORMATS[kind]
+            label = f"{material_name}.{kind}"
+            if kind in MAP_SLOTS:
+                slot = MAP_SLOTS[kind]
+                self._textures[key] = slot.build(self.gpu, self._depth_data(material), material.height_scale, label)
             else:
-                data, fmt = textures.load_albedo(material.albedo), _TEXTURE_FORMATS[kind]
-            self._textures[key] = create_texture(self.gpu, mip_chain(data), fmt, f"{material_name}.{kind}")
-            self.created.append(f"texture:{material_name}.{kind}")
+                if kind == "normal":
+                    data = self._normal_data(material) * 0.5 + 0.5
+                else:
+                    data = textures.load_albedo(material.albedo)
+                self._textures[key] = create_texture(self.gpu, mip_chain(data), _TEXTURE_FORMATS[kind], label)
+            self.created.append(f"texture:{label}")
         return self._textures[key]
 
     @staticmethod
@@ -137,8 +145,8 @@ class Renderer:
                 {"binding": 1, "visibility": F, "sampler": {"type": "filtering"}},
             ] + [
                 {"binding": _TEXTURE_BINDINGS[t], "visibility": F, "texture": {"sample_type": "float"}}
-                for t in technique.textures
-            ]
+                for t in technique.textures if t in _TEXTURE_BINDINGS
+            ] + layout_entries(technique.textures, F)
             self._material_layouts[technique.textures] = self.gpu.device.create_bind_group_layout(
                 label="material:" + "+".join(technique.textures), entries=entries
             )
@@ -155,7 +163,7 @@ class Renderer:
             )
             entries = [{"binding": 0, "resource": {"buffer": params}}, {"binding": 1, "resource": self._sampler}]
             entries += [
-                {"binding": _TEXTURE_BINDINGS[t], "resource": self._texture(material_name, t).create_view()}
+                {"binding": _binding(t), "resource": self._texture(material_name, t).create_view()}
                 for t in technique.textures
             ]
             group = device.create_bind_group(layout=self._material_layout(technique), entries=entries)
@@ -229,8 +237,17 @@ class Renderer:
         camera: Camera,
         size: tuple[int, int],
         mode: str = "color",
+        *,
+        clear: bool = True,
+        scissor: tuple[int, int, int, int] | None = None,
+        timestamp_writes: dict | None = None,
     ) -> None:
-        """Record one frame of ``technique_name`` into ``color_views`` (1 target: fs_color; 2: fs_data)."""
+        """Record one frame of ``technique_name`` into ``color_views`` (1 target: fs_color; 2: fs_data).
+
+        ``clear=False`` keeps what the targets hold and ``scissor`` (x, y, w, h) limits the drawing:
+        together they put several techniques side by side in one frame. ``timestamp_writes`` goes to
+        the render pass as is (GPU timing).
+        """
         technique = get_technique(technique_name)
         params = self.params.get(technique.name) or technique.defaults()
         cost_scale = float(params.get("layers", 1)) + 2.0
@@ -247,7 +264,10 @@ class Renderer:
             groups[material_name] = group
         background = [*self.scene.background, 0.0]
         attachments = [
-            {"view": v, "load_op": "clear", "store_op": "store", "clear_value": background if i == 0 else (0, 0, 0, 0)}
+            {
+                "view": v, "load_op": "clear" if clear else "load", "store_op": "store",
+                "clear_value": background if i == 0 else (0, 0, 0, 0),
+            }
             for i, v in enumerate(color_views)
         ]
         rpass = encoder.begin_render_pass(
@@ -256,7 +276,10 @@ class Renderer:
             depth_stencil_attachment={
                 "view": depth_view, "depth_load_op": "clear", "depth_store_op": "discard", "depth_clear_value": 1.0,
             },
+            timestamp_writes=timestamp_writes,
         )
+        if scissor is not None:
+            rpass.set_scissor_rect(*scissor)
         rpass.set_pipeline(pipeline)
         rpass.set_bind_group(0, self._frame_group)
         for material_name, vbuf, count, object_group in self._objects:

@@ -22,6 +22,8 @@ struct TraceResult {
 @group(1) @binding(2) var albedo_tex: texture_2d<f32>;
 @group(1) @binding(3) var normal_tex: texture_2d<f32>;
 @group(1) @binding(4) var depth_tex: texture_2d<f32>;
+// Maps derived from the depth map (wgpuviewer/maps.py); bound only for techniques that need them.
+@group(1) @binding(5) var complexity_tex: texture_2d<f32>;
 
 // Counted so every technique reports its cost the same way.
 var<private> fetch_count: u32;
