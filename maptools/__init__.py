@@ -1,4 +1,4 @@
-"""Map generation for relief mapping: normal, complexity and maximum-pyramid maps from height maps.
+"""Map generation for relief mapping: normal, complexity, maximum-pyramid and 3D distance maps from height maps.
 
 Each kind has a WGSL compute kernel (``wgpuviewer.wgsl.maps``), a CPU implementation (OpenCV/numpy) that is
 both the fallback and the cross-check, and an entry in :data:`maptools.registry.KINDS`.
@@ -45,7 +45,8 @@ def resolve_backend(backend: str = "auto") -> str:
 def generate(kind: str, height, backend: str = "auto", **options):
     """Generate map ``kind`` from ``height`` (float (H, W) in [0, 1]) on ``backend`` (auto, gpu, cpu).
 
-    normal -> float32 (H, W, 3); complexity -> uint8 (H, W); maxmip -> list of float32 arrays (level 0 first).
+    normal -> float32 (H, W, 3); complexity -> uint8 (H, W); maxmip -> list of float32 arrays (level 0 first);
+    distance, distance_refined -> float32 (Dz, H, W) volumes (docs/maps.md).
     """
     from .registry import get_kind
 

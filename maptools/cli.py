@@ -97,6 +97,13 @@ def build_parser() -> argparse.ArgumentParser:
     _add_input_options(chk)
 
     sub.add_parser("kinds", help="list the map kinds and their options")
+
+    ben = sub.add_parser("bench", help="GPU vs CPU time per kind and size, side by side (one run, same machine)")
+    ben.add_argument("--kinds", default=None, help="comma-separated kinds (default all)")
+    ben.add_argument("--sizes", default="64,256,1024", help="square sizes for the 2D kinds")
+    ben.add_argument("--volume-sizes", default="32,64,128", help="square sizes for distance (slices 16)")
+    ben.add_argument("--refined-sizes", default="16,32", help="square sizes for distance_refined (slices 8)")
+    ben.add_argument("--repeat", type=int, default=3, help="timed runs per cell (best is reported)")
     return parser
 
 
@@ -290,6 +297,57 @@ def cmd_check(args) -> int:
     return 1 if bad else 0
 
 
+def _sizes(text: str, flag: str) -> list[int]:
+    try:
+        sizes = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise UserError(f"{flag} {text!r}: expected comma-separated integers, e.g. 64,256") from None
+    if any(n < 1 or n > 8192 for n in sizes):
+        raise UserError(f"{flag} {text!r}: sizes must be in [1, 8192]")
+    return sizes
+
+
+#: kind -> (sizes flag attribute, options used by the benchmark)
+BENCH_SETUP = {"distance": ("volume_sizes", {"slices": 16, "height_scale": 0.05}),
+               "distance_refined": ("refined_sizes", {"slices": 8, "height_scale": 0.25, "angle_step": 10.0})}
+
+
+def _best_time(fn, repeat: int) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def cmd_bench(args) -> int:
+    """Best-of-N wall time of the CPU and GPU paths (GPU time includes upload and read-back)."""
+    import numpy as np
+
+    from . import gpu
+
+    kinds = _parse_kinds(args.kinds)
+    if args.repeat < 1:
+        raise UserError(f"--repeat {args.repeat}: must be >= 1")
+    g = gpu.runner()
+    print(f"adapter: {g.gpu.summary}")
+    print(f"{'kind':<17} {'size':>11} {'cpu s':>9} {'gpu s':>9} {'cpu/gpu':>8}")
+    rng = np.random.default_rng(0)
+    for k in kinds:
+        attr, opts = BENCH_SETUP.get(k, ("sizes", {}))
+        kind = get_kind(k)
+        opts = kind.resolve(opts)
+        for n in _sizes(getattr(args, attr), _flag(attr)):
+            height = rng.random((n, n)).astype(np.float32)
+            kind.gpu(height, **opts)  # warm-up: pipeline compilation
+            tg = _best_time(lambda: kind.gpu(height, **opts), args.repeat)
+            tc = _best_time(lambda: kind.cpu(height, **opts), args.repeat)
+            size = f"{n}x{n}" + (f"x{opts['slices']}" if "slices" in opts else "")
+            print(f"{k:<17} {size:>11} {tc:9.4f} {tg:9.4f} {tc / tg:8.2f}")
+    return 0
+
+
 def cmd_kinds(args) -> int:
     for kind in KINDS.values():
         print(f"{kind.name}: {kind.description}")
@@ -306,7 +364,8 @@ def main(argv=None) -> int:
     except SystemExit as exc:  # argparse: usage errors (2) and --help (0)
         return int(exc.code or 0)
     try:
-        return {"generate": cmd_generate, "batch": cmd_batch, "check": cmd_check, "kinds": cmd_kinds}[args.command](args)
+        return {"generate": cmd_generate, "batch": cmd_batch, "check": cmd_check, "kinds": cmd_kinds,
+                "bench": cmd_bench}[args.command](args)
     except UserError as exc:
         print(f"maptools: error: {exc}", file=sys.stderr)
         return 2

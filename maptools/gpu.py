@@ -189,3 +189,90 @@ def maxmip(g: MapGpu, height: np.ndarray):
     for k, (ph, pw) in enumerate(sizes[1:], start=1):
         out.append(g.read(bufs[k], ph * pw).reshape(ph, pw))
     return out
+
+
+# -- 3D distance maps ------------------------------------------------------------------------------------
+
+def _dispatch3(g: MapGpu, encoder, file: str, entry: str, bindings: dict, w: int, h: int, d: int) -> None:
+    pipe = g.pipeline(file, entry)
+    group = g.device.create_bind_group(
+        label=f"maptools {file}:{entry}", layout=pipe.get_bind_group_layout(0),
+        entries=[{"binding": b, "resource": {"buffer": buf}} for b, buf in bindings.items()])
+    cp = encoder.begin_compute_pass(label=f"maptools {file}:{entry}")
+    cp.set_pipeline(pipe)
+    cp.set_bind_group(0, group)
+    cp.dispatch_workgroups((w + _WG - 1) // _WG, (h + _WG - 1) // _WG, d)
+    cp.end()
+
+
+def _check_volume(g: MapGpu, w: int, h: int, slices: int) -> None:
+    g.check_size(h, w)
+    need = w * h * slices * 4
+    limits = g.device.limits
+    cap = min(limits["max-storage-buffer-binding-size"], limits["max-buffer-size"])
+    if need > cap or slices > limits["max-compute-workgroups-per-dimension"]:
+        raise UserError(f"a {w}x{h}x{slices} volume ({need} bytes) exceeds this adapter's limits; "
+                        f"use fewer --slices or --backend cpu")
+
+
+def _distance_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale: float, free: bool,
+                     stored: bool, label: str):
+    """Encode tops + pass_x + pass_y; returns the output volume buffer."""
+    from . import distance as dist
+
+    subtract = dist.half_diagonal(w, h, slices, height_scale) + dist.STORE_MARGIN
+    mode = 1 if free else 0
+    tops = g.storage(w * h * 4, f"maptools {label} tops")
+    g1 = g.storage(w * h * slices * 4, f"maptools {label} row pass")
+    out = g.storage(w * h * slices * 4, f"maptools {label} volume")
+    common = [w, h, slices]
+    p_tops = g.uniform(common + [mode, float(height_scale * w), float((w / h) ** 2), 0.0, 0.0],
+                       f"maptools {label} tops params")
+    p_y = g.uniform(common + [1 if stored else 0, float(height_scale * w), float((w / h) ** 2), float(subtract), 0.0],
+                    f"maptools {label} column params")
+    _dispatch3(g, enc, "distance.wgsl", "tops", {0: p_tops, 1: src, 2: tops}, w, h, 1)
+    _dispatch3(g, enc, "distance.wgsl", "pass_x", {0: p_tops, 1: tops, 2: g1}, w, h, slices)
+    _dispatch3(g, enc, "distance.wgsl", "pass_y", {0: p_y, 1: g1, 2: out}, w, h, slices)
+    return out
+
+
+@_guard
+def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05):
+    """GPU twin of distance.distance (distance.wgsl)."""
+    from . import distance as dist
+
+    h, w = height.shape
+    dist.check_volume(w, h, slices)
+    _check_volume(g, w, h, slices)
+    src = g.storage(height, "maptools distance src")
+    enc = g.encoder("maptools distance")
+    out = _distance_volume(g, enc, src, w, h, slices, height_scale, False, True, "distance")
+    g.submit(enc, "distance")
+    return g.read(out, w * h * slices).reshape(slices, h, w)
+
+
+@_guard
+def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05,
+                     max_angle: float = 80.0, angle_step: float = 6.0):
+    """GPU twin of distance.distance_refined (distance.wgsl raw volumes, then distance_refined.wgsl)."""
+    from . import distance as dist
+
+    h, w = height.shape
+    dist.check_volume(w, h, slices, "distance_refined")
+    _check_volume(g, w, h, slices)
+    dirs, alpha = dist.cone_directions(max_angle, angle_step)
+    d4 = np.zeros((len(dirs), 4), np.float32)
+    d4[:, :3] = dirs
+    src = g.storage(height, "maptools distance_refined src")
+    enc = g.encoder("maptools distance_refined")
+    ds = _distance_volume(g, enc, src, w, h, slices, height_scale, False, False, "distance_refined solid")
+    df = _distance_volume(g, enc, src, w, h, slices, height_scale, True, False, "distance_refined free")
+    dirbuf = g.storage(d4, "maptools distance_refined directions")
+    out = g.storage(w * h * slices * 4, "maptools distance_refined volume")
+    sx, sy, sz = dist.spacing(w, h, slices, height_scale)
+    params = g.uniform([w, h, slices, len(dirs), float(sx), float(sy), float(sz),
+                        float(dist.half_diagonal(w, h, slices, height_scale)), float(alpha),
+                        float(dist.STORE_MARGIN), 0.0, 0.0], "maptools distance_refined params")
+    _dispatch3(g, enc, "distance_refined.wgsl", "main", {0: params, 1: ds, 2: df, 3: dirbuf, 4: out}, w, h, slices)
+    g.submit(enc, "distance_refined")
+    return g.read(out, w * h * slices).reshape(slices, h, w)

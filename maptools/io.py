@@ -203,6 +203,11 @@ def write_maxmip(f, levels: list, ext: str, bits: int = 8) -> None:
     np.savez(f, **{f"level{i}": np.asarray(a, np.float32) for i, a in enumerate(levels)})
 
 
+def write_volume(f, vol, ext: str, bits: int = 8) -> None:
+    """.npy: float32 (Dz, H, W) volume (slice k = layer depth t in [k/Dz, (k+1)/Dz])."""
+    np.save(f, np.asarray(vol, np.float32))
+
+
 def write_result(kind, result, path, bits: int = 8) -> Path:
     path = Path(path)
     ext = path.suffix.lower()

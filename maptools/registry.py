@@ -11,6 +11,7 @@ import numpy as np
 from wgpuviewer.errors import UserError
 
 from . import cpu, gpu, io
+from . import distance as dist
 
 
 @dataclass(frozen=True)
@@ -115,6 +116,49 @@ def _check_complexity(o: dict) -> None:
         raise UserError("complexity: dilation radius (dilate_kernel//2 * iterations) must be <= 1024")
 
 
+#: Distance volumes: absolute difference in texel-metric units (float32 sqrt/sums vs float64; measured <= 5e-7 on
+#: lavapipe). Far below the STORE_MARGIN (1e-3) that every stored value already subtracts for rounding.
+DISTANCE_TOL = 1e-4
+#: Refined volumes: the same, on all but this fraction of voxels (a float32 vs float64 nearest-voxel or stop
+#: decision can flip at a boundary; both results are conservative either way). Measured 0 on lavapipe.
+REFINED_MAX_FLIPPED = 5e-3
+#: Cap on the sampled cone directions of distance_refined (cost is linear in it).
+MAX_DIRECTIONS = 20000
+
+
+def _compare_distance(a, b, opts) -> Comparison:
+    if np.shape(a) != np.shape(b):
+        return Comparison(math.inf, math.inf, False, "shapes differ")
+    d = np.abs(np.asarray(a, np.float64) - np.asarray(b, np.float64))
+    mx = float(d.max()) if d.size else 0.0
+    return Comparison(mx, float(d.mean()) if d.size else 0.0, mx <= DISTANCE_TOL)
+
+
+def _compare_refined(a, b, opts) -> Comparison:
+    if np.shape(a) != np.shape(b):
+        return Comparison(math.inf, math.inf, False, "shapes differ")
+    d = np.abs(np.asarray(a, np.float64) - np.asarray(b, np.float64))
+    frac = float((d > DISTANCE_TOL).mean()) if d.size else 0.0
+    return Comparison(float(d.max()) if d.size else 0.0, float(d.mean()) if d.size else 0.0,
+                      frac <= REFINED_MAX_FLIPPED,
+                      f"{frac:.2e} of voxels differ by > {DISTANCE_TOL:g} (allowed {REFINED_MAX_FLIPPED:g})")
+
+
+def _check_refined(o: dict) -> None:
+    if o["angle_step"] > o["max_angle"]:
+        raise UserError(f"distance_refined: angle_step ({o['angle_step']:g}) must be <= max_angle ({o['max_angle']:g})")
+    n = len(dist.cone_directions(o["max_angle"], o["angle_step"])[0])
+    if n > MAX_DIRECTIONS:
+        raise UserError(f"distance_refined: angle_step {o['angle_step']:g} samples {n} directions, more than "
+                        f"{MAX_DIRECTIONS}; use a larger angle_step")
+
+
+_VOLUME_OPTIONS = (
+    Option("slices", 16, int, "depth slices Dz of the volume (t in [0, 1])", lo=1, hi=256),
+    Option("height_scale", 0.05, float, "relief depth S in UV units the map is built for (metric: depth x S*W)",
+           lo=1e-3, hi=1.0),
+)
+
 BORDER_HELP = "border handling: repeat (wrap, tiling textures), clamp, reflect (OpenCV's reflect-101)"
 
 KINDS: dict[str, Kind] = {
@@ -153,6 +197,29 @@ KINDS: dict[str, Kind] = {
         cpu=cpu.maxmip, gpu=gpu.maxmip, compare=_compare_maxmip,
         tolerance="exact (max is exact)",
         writer=io.write_maxmip, extensions=(".npz",),
+    ),
+    "distance": Kind(
+        name="distance",
+        description="3D distance map (Donnelly), float32 (Dz, H, W): safe sphere-tracing radius per voxel in texels "
+                    "of u (v scaled by W/H, depth by S*W); periodic in u, v",
+        options=_VOLUME_OPTIONS,
+        cpu=dist.distance, gpu=gpu.distance, compare=_compare_distance,
+        tolerance=f"max |difference| <= {DISTANCE_TOL:g} texel",
+        writer=io.write_volume, extensions=(".npy",),
+    ),
+    "distance_refined": Kind(
+        name="distance_refined",
+        description="visibility-refined distance map (seed 000): safe step for every ray in the view cone that "
+                    "reaches the voxel unoccluded; same layout and metric as distance",
+        options=_VOLUME_OPTIONS + (
+            Option("max_angle", 80.0, float, "half-angle of the admissible view cone, degrees from the normal",
+                   lo=1.0, hi=89.0),
+            Option("angle_step", 6.0, float, "direction sampling step, degrees (= covering angle alpha)",
+                   lo=0.5, hi=45.0),
+        ),
+        cpu=dist.distance_refined, gpu=gpu.distance_refined, compare=_compare_refined,
+        tolerance=f"|difference| <= {DISTANCE_TOL:g} texel on all but {REFINED_MAX_FLIPPED:g} of voxels",
+        writer=io.write_volume, extensions=(".npy",), check=_check_refined,
     ),
 }
 

@@ -217,7 +217,7 @@ def test_bad_arrays_are_user_errors(bad):
 
 def test_unknown_kind_and_backend():
     with pytest.raises(UserError, match="unknown map kind"):
-        maptools.generate("cone", MAPS["spike"], backend="cpu")
+        maptools.generate("bogus", MAPS["spike"], backend="cpu")
     with pytest.raises(UserError, match="--backend"):
         maptools.generate("normal", MAPS["spike"], backend="vulkan")
 
