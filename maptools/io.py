@@ -146,6 +146,13 @@ def load_height_input(path, channel: str = "auto", nan_policy: str = "error") ->
 
 # -- writing ----------------------------------------------------------------------------------------
 
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 @contextlib.contextmanager
 def atomic_open(path):
     """Open a temp file next to ``path``; on success it replaces ``path``, on any error it is removed."""
@@ -157,6 +164,7 @@ def atomic_open(path):
             yield f
             f.flush()
             os.fsync(f.fileno())
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600 files; outputs get the usual mode
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import cv2
 import numpy as np
+from maptools.io import atomic_open
 
 from .errors import UserError
 from .renderer import OffscreenImage
@@ -60,39 +59,19 @@ def mode_picture(image: OffscreenImage, mode: str) -> np.ndarray:
     return rgb
 
 
-def write_atomic(path: Path, write) -> None:
-    """Call ``write(tmp_path)`` and move the result into place: readers never see a partial file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600 files; outputs get the usual mode
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def save_rgb_png(path: Path, rgb: np.ndarray) -> None:
-    def write(tmp: Path):
-        if not cv2.imwrite(str(tmp), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
-            raise UserError(f"{path}: could not write PNG")
-
-    write_atomic(path, write)
+    ok, encoded = cv2.imencode(".png", cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    if not ok:
+        raise UserError(f"{path}: could not encode the PNG")
+    with atomic_open(path) as f:  # readers never see a partial file
+        f.write(encoded.tobytes())
 
 
 def save_output(path: Path, image: OffscreenImage, mode: str) -> None:
     path = Path(path)
     if path.suffix.lower() == ".npy":
         data = mode_data(image, mode)
-        write_atomic(path, lambda tmp: np.save(tmp, data))
+        with atomic_open(path) as f:
+            np.save(f, data)
     else:
         save_rgb_png(path, mode_picture(image, mode))
