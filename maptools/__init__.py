@@ -46,7 +46,7 @@ def generate(kind: str, height, backend: str = "auto", **options):
     """Generate map ``kind`` from ``height`` (float (H, W) in [0, 1]) on ``backend`` (auto, gpu, cpu).
 
     normal -> float32 (H, W, 3); complexity -> uint8 (H, W); maxmip -> list of float32 arrays (level 0 first);
-    distance, distance_refined -> float32 (Dz, H, W) volumes (docs/maps.md).
+    distance, distance_refined -> float32 (Dz, H, W) volumes; cone -> float32 (H, W) ratios (docs/maps.md).
     """
     from .registry import get_kind
 

@@ -276,3 +276,26 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
     _dispatch3(g, enc, "distance_refined.wgsl", "main", {0: params, 1: ds, 2: df, 3: dirbuf, 4: out}, w, h, slices)
     g.submit(enc, "distance_refined")
     return g.read(out, w * h * slices).reshape(slices, h, w)
+
+
+@_guard
+def cone(g: MapGpu, height: np.ndarray, *, max_ratio: float = 16.0, filter: str = "bilinear"):
+    """GPU twin of cone.cone (cone.wgsl: ratio, then min3x3 for filter=bilinear)."""
+    from . import cone as cn
+
+    h, w = height.shape
+    cn.check(w, h, max_ratio)
+    g.check_size(h, w)
+    dmin = float(np.min(np.float32(1.0) - height))
+    src = g.storage(height, "maptools cone src")
+    raw = g.storage(h * w * 4, "maptools cone raw")
+    out = g.storage(h * w * 4, "maptools cone out")
+    params = g.uniform([w, h, cn.ring_count(max_ratio, w, h), 0, float(w / h), float(max_ratio),
+                        float(1.0 - cn.STORE_MARGIN), dmin, float(cn.EXIT_BAND), 0.0, 0.0, 0.0],
+                       "maptools cone params")
+    enc = g.encoder("maptools cone")
+    g.dispatch(enc, "cone.wgsl", "ratio", {0: params, 1: src, 2: raw}, w, h)
+    if filter == "bilinear":
+        g.dispatch(enc, "cone.wgsl", "min3x3", {0: params, 1: raw, 2: out}, w, h)
+    g.submit(enc, "cone")
+    return g.read(out if filter == "bilinear" else raw, h * w).reshape(h, w)

@@ -11,6 +11,7 @@ import numpy as np
 from wgpuviewer.errors import UserError
 
 from . import cpu, gpu, io
+from . import cone as cn
 from . import distance as dist
 
 
@@ -153,6 +154,24 @@ def _check_refined(o: dict) -> None:
                         f"{MAX_DIRECTIONS}; use a larger angle_step")
 
 
+#: Cone ratios: relative difference (float32 GPU arithmetic vs float64 CPU, both then lose the 2^-12 store margin).
+CONE_REL_TOL = 1e-5
+#: ... on all but this fraction of texels (a "may exit" decision inside the float band can flip; either result is
+#: conservative). Measured 0 on lavapipe.
+CONE_MAX_FLIPPED = 5e-3
+
+
+def _compare_cone(a, b, opts) -> Comparison:
+    if np.shape(a) != np.shape(b):
+        return Comparison(math.inf, math.inf, False, "shapes differ")
+    a64, b64 = np.asarray(a, np.float64), np.asarray(b, np.float64)
+    rel = np.abs(a64 - b64) / np.maximum(np.maximum(a64, b64), 1e-6)
+    frac = float((rel > CONE_REL_TOL).mean()) if rel.size else 0.0
+    return Comparison(float(rel.max()) if rel.size else 0.0, float(rel.mean()) if rel.size else 0.0,
+                      frac <= CONE_MAX_FLIPPED,
+                      f"relative; {frac:.2e} of texels differ by > {CONE_REL_TOL:g} (allowed {CONE_MAX_FLIPPED:g})")
+
+
 _VOLUME_OPTIONS = (
     Option("slices", 16, int, "depth slices Dz of the volume (t in [0, 1])", lo=1, hi=256),
     Option("height_scale", 0.05, float, "relief depth S in UV units the map is built for (metric: depth x S*W)",
@@ -220,6 +239,20 @@ KINDS: dict[str, Kind] = {
         cpu=dist.distance_refined, gpu=gpu.distance_refined, compare=_compare_refined,
         tolerance=f"|difference| <= {DISTANCE_TOL:g} texel on all but {REFINED_MAX_FLIPPED:g} of voxels",
         writer=io.write_volume, extensions=(".npy",), check=_check_refined,
+    ),
+    "cone": Kind(
+        name="cone",
+        description="relaxed cone map (Policarpo & Oliveira 2007), float32 (H, W): cone ratio in texels of u per "
+                    "unit of layer depth t, conservative for the bilinear surface (docs/maps.md)",
+        options=(
+            Option("max_ratio", 16.0, float, "largest stored ratio (texels per unit t); bounds the search to "
+                   "about (2 max_ratio)^2 cells per texel", lo=0.25, hi=cn.PNG_SCALE),
+            Option("filter", "bilinear", str, "lookup the tracer uses: bilinear (3x3 min; safe for bilinear and "
+                   "nearest lookups) or nearest (larger cones, nearest lookups only)", choices=cn.FILTERS),
+        ),
+        cpu=cn.cone, gpu=gpu.cone, compare=_compare_cone,
+        tolerance=f"relative difference <= {CONE_REL_TOL:g} on all but {CONE_MAX_FLIPPED:g} of texels",
+        writer=io.write_cone, extensions=(".npy", ".png"),
     ),
 }
 

@@ -46,3 +46,109 @@ def sphere_trace(vol: np.ndarray, uv0, view_dir, height_scale: float, *, stop: f
         y[go] += mg * wy[go]
         z[go] += mg * wz[go]
     return z / sw, steps, ~done
+
+
+#: cone_trace outcomes
+BRACKETED, GAP_STOP, CAPPED = 0, 1, 2
+
+
+def _lookup_nearest(cmap: np.ndarray, x, y):
+    h, w = cmap.shape
+    i = np.mod(np.floor(x), w).astype(np.int64)
+    j = np.mod(np.floor(y * h / w), h).astype(np.int64)
+    return cmap.ravel()[j * w + i].astype(np.float64)
+
+
+def _lookup_bilinear(cmap: np.ndarray, x, y):
+    """Bilinear between texel centres, repeat addressing (the GPU sampler's filter, ideal weights)."""
+    h, w = cmap.shape
+    fx, fy = x - 0.5, y * h / w - 0.5
+    cx, cy = np.floor(fx), np.floor(fy)
+    ax, ay = fx - cx, fy - cy
+    flat = np.asarray(cmap, np.float64).ravel()
+    i0, i1 = np.mod(cx, w).astype(np.int64), np.mod(cx + 1, w).astype(np.int64)
+    j0, j1 = np.mod(cy, h).astype(np.int64) * w, np.mod(cy + 1, h).astype(np.int64) * w
+    return ((flat[j0 + i0] * (1 - ax) + flat[j0 + i1] * ax) * (1 - ay)
+            + (flat[j1 + i0] * (1 - ax) + flat[j1 + i1] * ax) * ay)
+
+
+def cone_trace(cmap: np.ndarray, depth: np.ndarray, uv0, view_dir, height_scale: float, *, lookup: str = "nearest",
+               max_steps: int = 256, gap_stop: float = 1e-5, bisect: int = 16):
+    """Relaxed cone stepping (docs/maps.md, "Relaxed cone map"), float64, vectorised over rays.
+
+    ``cmap`` (H, W): cone ratios (texels of u per unit t); ``depth`` (H, W): D = 1 - H, sampled bilinear with
+    repeat addressing (``wgpuviewer.reference.sample_bilinear``). Per ray, from t = 0 at uv0, with
+    k = |V.xy / V.z| * S * W (texels travelled per unit t):
+
+        loop (<= max_steps):  D = depth(p) (bilinear);  if t >= D: bracket [t_prev, t]; break
+                              if D - t <= gap_stop: stop (GAP_STOP); break
+                              c = cone(p) (nearest texel, or bilinear if the map was built with filter=bilinear)
+                              dt = (D - t) * (c / (k + c))   (dt = D - t when k == 0)
+                              t_prev = t;  t += dt;  uv -= dt * (V.xy / V.z) * S
+        then ``bisect`` halvings of [t_prev, t] keeping a free lower and a solid upper end.
+
+    Returns a dict of arrays: t (final: the solid end of the bracket, or the stop point), lo / hi (the cone phase's
+    bracket: lo = last free point, hi = first solid point; hi = NaN without a bracket), steps (cone steps = depth
+    fetches of the cone phase), status (BRACKETED, GAP_STOP, CAPPED).
+    """
+    from wgpuviewer.reference import sample_bilinear
+
+    rows, cols = depth.shape
+    uv0 = np.atleast_2d(np.asarray(uv0, np.float64))
+    v = np.atleast_2d(np.asarray(view_dir, np.float64))
+    n = max(len(uv0), len(v))
+    uv0, v = np.broadcast_to(uv0, (n, 2)), np.broadcast_to(v, (n, 3))
+    if not (v[:, 2] > 0).all():
+        raise ValueError("cone_trace needs V.z > 0 for every ray")
+    dxy = -v[:, :2] / v[:, 2:3] * height_scale * cols  # texels of u per unit t
+    k = np.hypot(dxy[:, 0], dxy[:, 1])
+    p0 = uv0 * cols
+    t = np.zeros(n)
+    lo = np.zeros(n)
+    hi = np.full(n, np.nan)
+    steps = np.zeros(n, np.int64)
+    status = np.full(n, CAPPED)
+    run = np.arange(n)
+
+    def depth_at(idx, tt):
+        p = p0[idx] + tt[:, None] * dxy[idx]
+        return sample_bilinear(depth, p / cols), p
+
+    for _ in range(max_steps):
+        if not run.size:
+            break
+        d, p = depth_at(run, t[run])
+        steps[run] += 1
+        solid = t[run] >= d
+        hi[run[solid]] = t[run[solid]]
+        status[run[solid]] = BRACKETED
+        gap = (~solid) & (d - t[run] <= gap_stop)
+        status[run[gap]] = GAP_STOP
+        go = ~(solid | gap)
+        idx, d, p = run[go], d[go], p[go]
+        if lookup == "nearest":
+            c = _lookup_nearest(cmap, p[:, 0], p[:, 1])
+        else:
+            c = _lookup_bilinear(cmap, p[:, 0], p[:, 1])
+        kk = k[idx]
+        frac = np.where(kk > 0, c / np.where(kk + c > 0, kk + c, 1.0), 1.0)
+        lo[idx] = t[idx]
+        t[idx] = t[idx] + (d - t[idx]) * frac
+        run = idx
+    # binary search inside the brackets: lo free, hi solid
+    b = np.flatnonzero(status == BRACKETED)
+    a_lo, a_hi = lo[b].copy(), hi[b].copy()
+    for _ in range(bisect):
+        mid = 0.5 * (a_lo + a_hi)
+        d, _ = depth_at(b, mid)
+        s = mid >= d
+        a_hi = np.where(s, mid, a_hi)
+        a_lo = np.where(s, a_lo, mid)
+    t[b] = a_hi
+    return {"t": t, "lo": lo, "hi": hi, "steps": steps, "status": status, "bisect_lo": _put(n, b, a_lo)}
+
+
+def _put(n, idx, vals):
+    out = np.full(n, np.nan)
+    out[idx] = vals
+    return out
