@@ -17,7 +17,7 @@ from pathlib import Path
 from wgpuviewer.errors import UserError
 
 from . import VERSION, generate, load_height_input, resolve_backend
-from .io import CHANNELS, INPUT_EXTS, NAN_POLICIES, atomic_open, write_result
+from .io import CHANNELS, INPUT_EXTS, NAN_POLICIES, atomic_open, remove_stale_temps, write_result
 from .registry import KINDS, get_kind
 
 
@@ -226,6 +226,7 @@ def cmd_batch(args) -> int:
                 if not args.force and up_to_date(out, key):
                     res.append((str(f), k, "skipped", "up to date"))
                     continue
+                remove_stale_temps(out)  # left by a killed earlier run: this job owns `out`
                 if height is None:
                     height = load_height_input(f, args.channel, args.nan_policy)
                 result = generate(k, height, backend=backend, **kopts[k])

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import tempfile
 from pathlib import Path
@@ -153,75 +154,13 @@ def _umask() -> int:
     return mask
 
 
-def _anonymous_file(folder: Path):
-    """An unnamed file in ``folder`` (Linux O_TMPFILE): a process killed before the commit leaves nothing behind.
-    None where the platform or file system does not support it."""
-    flag = getattr(os, "O_TMPFILE", None)
-    if flag is None or not os.path.isdir("/proc/self/fd"):
-        return None
-    try:
-        return os.open(folder, flag | os.O_RDWR | getattr(os, "O_CLOEXEC", 0), 0o666 & ~_umask())
-    except OSError:
-        return None
-
-
-def _commit_anonymous(fd: int, path: Path) -> None:
-    """Give the unnamed file its name: a hard link straight to ``path`` when it does not exist yet (nothing to
-    clean up whatever happens), else a link to a unique temp name and os.replace (a window of one rename)."""
-    src = f"/proc/self/fd/{fd}"
-    try:
-        os.link(src, path, follow_symlinks=True)
-        return
-    except FileExistsError:
-        pass
-    for _ in range(100):
-        tmp = path.with_name(f".{path.name}.{os.urandom(6).hex()}.tmp")
-        try:
-            os.link(src, tmp, follow_symlinks=True)
-            break
-        except FileExistsError:
-            continue
-    else:  # pragma: no cover
-        raise OSError(f"cannot create a temp name next to {path}")
-    try:
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
 @contextlib.contextmanager
 def atomic_open(path):
-    """Open a temp file next to ``path``; on success it replaces ``path``, on any error it is removed.
-
-    On Linux the temp file is unnamed (O_TMPFILE) until the commit, so even SIGKILL leaves no partial or temporary
-    file; elsewhere a named ``.NAME.*.tmp`` file is used (removed on errors, but not after a kill)."""
+    """Open a temp file ``.NAME.*.tmp`` next to ``path``; on success it replaces ``path`` (one rename), on any
+    error it is removed. A process killed mid-write can leave only that hidden temp file, never a partial
+    ``path``; ``remove_stale_temps`` clears such leftovers."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd = _anonymous_file(path.parent)
-    if fd is not None:
-        with os.fdopen(fd, "w+b") as f:
-            yield f
-            f.flush()
-            os.fsync(f.fileno())
-            try:
-                _commit_anonymous(f.fileno(), path)
-            except OSError:
-                fd = None  # e.g. linking refused: fall back to a named temp file holding the same bytes
-                f.seek(0)
-                data = f.read()
-        if fd is not None:
-            return
-        with _named_atomic(path) as g:
-            g.write(data)
-        return
-    with _named_atomic(path) as f:
-        yield f
-
-
-@contextlib.contextmanager
-def _named_atomic(path: Path):
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as f:
@@ -234,6 +173,14 @@ def _named_atomic(path: Path):
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def remove_stale_temps(path) -> None:
+    """Remove temp files a killed writer of ``path`` left behind (only call for outputs this process owns)."""
+    path = Path(path)
+    for tmp in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
+        with contextlib.suppress(OSError):
+            tmp.unlink()
 
 
 def _png_bytes(img: np.ndarray) -> bytes:

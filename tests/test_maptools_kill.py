@@ -43,8 +43,10 @@ def test_sigkill_mid_batch_leaves_only_complete_outputs(tmp_path, capsys):
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == -signal.SIGKILL
-    names = sorted(p.name for p in out.iterdir())
-    assert not [n for n in names if n.startswith(".") or n.endswith(".tmp")], names  # no temp files
+    names = sorted(p.name for p in out.iterdir() if not p.name.startswith("."))
+    # a kill can leave at most a hidden temp file per job running at that moment, never a partial output
+    temps = [p.name for p in out.iterdir() if p.name.startswith(".")]
+    assert all(t.endswith(".tmp") for t in temps) and len(temps) <= 3, temps
     outputs = [out / n for n in names if not n.endswith(".json")]
     assert 0 < len(outputs) < 40 * 3
     for p in outputs:  # every output present is complete: it loads and equals a fresh single generate
