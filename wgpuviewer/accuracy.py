@@ -61,7 +61,16 @@ DEFAULT_ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 89.0, 89.9)
 DEFAULT_SETTINGS = (
     ("parallax", {}), ("parallax", {"offset_limiting": True}),
     ("steep", {"layers": 32}), ("pom", {"layers": 8}), ("pom", {"layers": 32}), ("pom", {"layers": 256}),
+    ("pom_adaptive", {}), ("pom_adaptive", {"angle_only": True}),
+    ("relief", {}), ("relief", {"linear_steps": 32, "binary_steps": 8}),
+    ("maxmip", {}), ("distance", {}), ("distance_refined", {}),
 )
+
+
+def npot_height(shape=(401, 343)) -> np.ndarray:
+    """A smooth non-square, non-power-of-two test relief (rows, cols) = (401, 343) by default."""
+    rows, cols = shape
+    return np.clip(0.5 + 0.2 * np.sin(np.arange(rows)[:, None] / 9.0) * np.cos(np.arange(cols)[None, :] / 7.0), 0, 1)
 
 
 def table(heightmaps: dict, angles=DEFAULT_ANGLES, settings=DEFAULT_SETTINGS, height_scale=0.05, rays=4096,

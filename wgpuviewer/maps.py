@@ -15,7 +15,9 @@ import numpy as np
 import wgpu
 from maptools.cache import cached_generate
 
+from .errors import UserError
 from .gpu import Gpu, create_texture, mip_chain
+from .techniques import REFINED_MAX_ANGLE
 
 
 @dataclass(frozen=True)
@@ -33,16 +35,84 @@ def _depth(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu
 def _complexity(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
     # Relief textures tile, so the Sobel and the dilation wrap around the borders.
     levels = cached_generate("complexity", 1.0 - depth, backend="auto", border="repeat")
-    return create_texture(gpu, [levels.astype(np.float32) / 255.0], "r8unorm", label)
+    # 8-bit levels k/255 as a filterable float texture (r8unorm has no upload path in gpu.to_texel_data).
+    return create_texture(gpu, [levels.astype(np.float32) / 255.0], gpu.depth_format, label)
 
+
+def cell_max_height(depth: np.ndarray) -> np.ndarray:
+    """Height bound of each bilinear cell: max of the cell's four corner texels (wrap), float32 (H, W).
+
+    Cell (i, j) lies between the texel centres i, i+1 and j, j+1 (texel coordinates x = u*W - 0.5); the bilinear
+    patch over it never rises above its highest corner, so a max pyramid over these values bounds the sampled
+    surface (a pyramid over the texels alone does not: a patch reaches into the neighbouring texel's cell).
+    """
+    h = 1.0 - np.asarray(depth, np.float64)
+    right = np.roll(h, -1, axis=1)
+    cell = np.maximum(np.maximum(h, right), np.maximum(np.roll(h, -1, axis=0), np.roll(right, -1, axis=0)))
+    return np.clip(cell, 0.0, 1.0).astype(np.float32)
+
+
+def maxmip_atlas(levels: list[np.ndarray]) -> np.ndarray:
+    """maptools' maxmip levels (ceil-halving) stacked into one (sum of heights, W) float32 image: level m at
+    rows [sum of earlier heights, + h_m), columns [0, w_m). maxmip.wgsl computes the same row offsets."""
+    width = levels[0].shape[1]
+    atlas = np.zeros((sum(level.shape[0] for level in levels), width), np.float32)
+    row = 0
+    for level in levels:
+        atlas[row:row + level.shape[0], :level.shape[1]] = level
+        row += level.shape[0]
+    return atlas
+
+
+def _maxmip(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    levels = cached_generate("maxmip", cell_max_height(depth), backend="auto")
+    return create_texture(gpu, [maxmip_atlas(levels)], "r32float", label)
+
+
+def _volume_texture(gpu: Gpu, volume: np.ndarray, label: str) -> wgpu.GPUTexture:
+    dz, h, w = volume.shape
+    limit = gpu.adapter.limits["max-texture-dimension-3d"]
+    if max(w, h, dz) > limit:
+        raise UserError(f"{label}: volume of {w}x{h}x{dz} exceeds this adapter's 3D limit of {limit} texels per side")
+    data = np.ascontiguousarray(volume, np.float32)
+    texture = gpu.device.create_texture(
+        label=label, size=(w, h, dz), dimension="3d", format="r32float",
+        usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
+    )
+    gpu.device.queue.write_texture(
+        {"texture": texture, "mip_level": 0, "origin": (0, 0, 0)}, data,
+        {"offset": 0, "bytes_per_row": w * 4, "rows_per_image": h}, (w, h, dz),
+    )
+    return texture
+
+
+def _distance(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    volume = cached_generate("distance", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
+                             height_scale=height_scale)
+    return _volume_texture(gpu, volume, label)
+
+
+def _distance_refined(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    volume = cached_generate("distance_refined", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
+                             height_scale=height_scale, max_angle=REFINED_MAX_ANGLE)
+    return _volume_texture(gpu, volume, label)
+
+
+#: Depth slices of the distance volumes (maptools' default).
+DISTANCE_SLICES = 16
 
 _FILTERABLE_2D = {"texture": {"sample_type": "float", "view_dimension": "2d"}}
+_VOLUME = {"texture": {"sample_type": "unfilterable-float", "view_dimension": "3d"}}
 
 MAP_SLOTS: dict[str, MapSlot] = {
     slot.name: slot
     for slot in (
         MapSlot("depth", 4, _FILTERABLE_2D, _depth),
         MapSlot("complexity", 5, _FILTERABLE_2D, _complexity),
+        MapSlot("maxmip", 6, {"texture": {"sample_type": "unfilterable-float", "view_dimension": "2d"}}, _maxmip),
+        # Both distance maps bind at the same slot: distance.wgsl reads whichever the technique needs.
+        MapSlot("distance", 7, _VOLUME, _distance),
+        MapSlot("distance_refined", 7, _VOLUME, _distance_refined),
     )
 }
 

@@ -11,7 +11,7 @@ from maptools.io import atomic_open
 from .errors import UserError
 from .renderer import OffscreenImage
 
-OUTPUT_MODES = ("color", "uv", "depth", "cost")
+OUTPUT_MODES = ("color", "uv", "depth", "cost", "layers")
 OUTPUT_SUFFIXES = (".png", ".npy")
 
 
@@ -19,7 +19,8 @@ def mode_data(image: OffscreenImage, mode: str) -> np.ndarray:
     """Raw float32 data of a mode; NaN where nothing was drawn (except colour, which shows the background).
 
     color: (H, W, 3) the sRGB image in [0, 1]; uv: (H, W, 2) hit UV (not wrapped);
-    depth: (H, W) hit layer depth t; cost: (H, W) depth fetches per pixel.
+    depth: (H, W) hit layer depth t; cost: (H, W) depth fetches per pixel; layers: (H, W) depth layers the
+    search used (pom_adaptive's N; 0 for techniques without layers).
     """
     if mode == "color":
         return image.color[:, :, :3].astype(np.float32) / 255.0
@@ -29,6 +30,8 @@ def mode_data(image: OffscreenImage, mode: str) -> np.ndarray:
         out = d[:, :, 0:2].copy()
     elif mode == "depth":
         out = d[:, :, 2].copy()
+    elif mode == "layers":
+        out = (image.layers if image.layers is not None else np.zeros(d.shape[:2])).astype(np.float32)
     else:
         fetches = d[:, :, 3]
         out = np.where(fetches < 0, -fetches - 1.0, fetches).astype(np.float32)  # capped rays are stored negative
@@ -47,6 +50,9 @@ def mode_picture(image: OffscreenImage, mode: str) -> np.ndarray:
         rgb[:, :, :2] = np.nan_to_num(data - np.floor(data))
         return np.rint(rgb * 255).astype(np.uint8)
     values = np.nan_to_num(data)
+    if mode == "layers":  # the thesis' debug view: (N - Nmin) / (Nmax - Nmin) as grey
+        lo, hi = image.layer_range
+        values = (values - lo) / max(hi - lo, 1.0)
     if mode == "cost":
         peak = max(float(values.max()), 1.0)
         values = values / peak

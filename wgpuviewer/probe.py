@@ -18,7 +18,7 @@ from .shaders import compose, pack_trace_params
 from .techniques import TECHNIQUES, get_technique, resolve_params
 
 _RAY_STRIDE = 32  # ProbeRay: vec2f uv, vec2f pad, vec4f view
-_HIT_STRIDE = 32  # ProbeHit: vec2f uv, f32 depth, u32 fetches, u32 capped, vec3u pad
+_HIT_STRIDE = 32  # ProbeHit: vec2f uv, f32 depth, u32 fetches, u32 capped, u32 layers, vec2u pad
 _WORKGROUP = 64
 _MAX_GROUPS = 65535  # per dispatch dimension
 
@@ -29,6 +29,7 @@ class ProbeResult:
     depth: np.ndarray  # (N,) float32 hit layer depth t
     fetches: np.ndarray  # (N,) uint32 depth fetches per ray
     capped: np.ndarray  # (N,) bool: a cap or clamp decided the result
+    layers: np.ndarray  # (N,) uint32 depth layers the search used (0: technique without layers)
 
 
 def _pipeline(gpu: Gpu, technique_name: str) -> tuple[wgpu.GPUComputePipeline, list]:
@@ -110,7 +111,7 @@ def probe(
     ray_buf = device.create_buffer_with_data(label="probe:rays", data=rays, usage=S.STORAGE)
     hit_buf = device.create_buffer(label="probe:hits", size=n * _HIT_STRIDE, usage=S.STORAGE | S.COPY_SRC)
     params_buf = device.create_buffer_with_data(
-        label="probe:params", data=pack_trace_params(height_scale, height.shape, values), usage=S.UNIFORM
+        label="probe:params", data=pack_trace_params(height_scale, height.shape, tech.trace_values(values)), usage=S.UNIFORM
     )
     depth = 1.0 - height
     maps = [(MAP_SLOTS[n], MAP_SLOTS[n].build(gpu, depth, height_scale, f"probe:{n}")) for n in tech.textures if n in MAP_SLOTS]
@@ -146,5 +147,6 @@ def probe(
     raw = np.frombuffer(device.queue.read_buffer(hit_buf), np.uint8).reshape(n, _HIT_STRIDE)
     f32 = raw.view(np.float32)
     u32 = raw.view(np.uint32)
-    return ProbeResult(uv=f32[:, 0:2].copy(), depth=f32[:, 2].copy(), fetches=u32[:, 3].copy(), capped=u32[:, 4] != 0)
+    return ProbeResult(uv=f32[:, 0:2].copy(), depth=f32[:, 2].copy(), fetches=u32[:, 3].copy(), capped=u32[:, 4] != 0,
+                       layers=u32[:, 5].copy())
 

@@ -25,12 +25,13 @@ from .techniques import Technique, get_technique
 MAX_LIGHTS = 4  # mirrors render.wgsl
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
 DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, depth, fetches
+LAYERS_FORMAT = "r32uint"  # offscreen: depth layers the search used per pixel
 DEPTH_FORMAT = "depth32float"
 FRAME_SIZE = 64 + 16 + 16 + MAX_LIGHTS * 32
 OBJECT_SIZE = 64 + 64 + 16
 
 #: Frame.mode values (render.wgsl).
-MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3}
+MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4}
 
 _TEXTURE_BINDINGS = {"albedo": 2, "normal": 3}  # height-derived ones: maps.MAP_SLOTS
 _TEXTURE_FORMATS = {"albedo": "rgba16float", "normal": "rgba8unorm"}
@@ -44,6 +45,8 @@ def _binding(texture_name: str) -> int:
 class OffscreenImage:
     color: np.ndarray  # (H, W, 4) uint8, sRGB; alpha 0 where nothing was drawn
     data: np.ndarray  # (H, W, 4) float32: hit u, hit v, hit depth, fetches (negative: capped)
+    layers: np.ndarray | None = None  # (H, W) uint32: depth layers the search used (0: no layers)
+    layer_range: tuple[float, float] = (0.0, 1.0)  # the layers mode's grey: (N - lo) / (hi - lo)
 
     @property
     def covered(self) -> np.ndarray:
@@ -242,7 +245,8 @@ class Renderer:
         scissor: tuple[int, int, int, int] | None = None,
         timestamp_writes: dict | None = None,
     ) -> None:
-        """Record one frame of ``technique_name`` into ``color_views`` (1 target: fs_color; 2: fs_data).
+        """Record one frame of ``technique_name`` into ``color_views`` (1 target: fs_color; 3: fs_data, formats
+        (COLOR_FORMAT, DATA_FORMAT, LAYERS_FORMAT)).
 
         ``clear=False`` keeps what the targets hold and ``scissor`` (x, y, w, h) limits the drawing:
         together they put several techniques side by side in one frame. ``timestamp_writes`` goes to
@@ -259,7 +263,7 @@ class Renderer:
             material = self.scene.materials[material_name]
             depth_shape = self._texture(material_name, "depth").size[1::-1] if technique.needs_depth else (1, 1)
             self.gpu.device.queue.write_buffer(
-                params_buffer, 0, pack_trace_params(material.height_scale, depth_shape, params)
+                params_buffer, 0, pack_trace_params(material.height_scale, depth_shape, technique.trace_values(params))
             )
             groups[material_name] = group
         background = [*self.scene.background, 0.0]
@@ -296,18 +300,30 @@ class Renderer:
         usage = wgpu.TextureUsage.RENDER_ATTACHMENT | wgpu.TextureUsage.COPY_SRC
         color = device.create_texture(label="offscreen:color", size=(w, h, 1), format=COLOR_FORMAT, usage=usage)
         data = device.create_texture(label="offscreen:data", size=(w, h, 1), format=DATA_FORMAT, usage=usage)
+        layers = device.create_texture(label="offscreen:layers", size=(w, h, 1), format=LAYERS_FORMAT, usage=usage)
         depth = device.create_texture(
             label="offscreen:depth", size=(w, h, 1), format=DEPTH_FORMAT, usage=wgpu.TextureUsage.RENDER_ATTACHMENT
         )
         encoder = device.create_command_encoder(label="offscreen")
         self.encode(
-            encoder, [color.create_view(), data.create_view()], depth.create_view(),
-            (COLOR_FORMAT, DATA_FORMAT), technique_name, camera or self.scene.camera, size,
+            encoder, [color.create_view(), data.create_view(), layers.create_view()], depth.create_view(),
+            (COLOR_FORMAT, DATA_FORMAT, LAYERS_FORMAT), technique_name, camera or self.scene.camera, size,
         )
         device.queue.submit([encoder.finish()])
+        technique = get_technique(technique_name)
         return OffscreenImage(
-            color=_read_texture(device, color, 4, np.uint8), data=_read_texture(device, data, 4, np.uint32).view(np.float32)
+            color=_read_texture(device, color, 4, np.uint8),
+            data=_read_texture(device, data, 4, np.uint32).view(np.float32),
+            layers=_read_texture(device, layers, 1, np.uint32)[:, :, 0],
+            layer_range=layer_range(self.params.get(technique.name) or technique.defaults()),
         )
+
+
+def layer_range(params: dict) -> tuple[float, float]:
+    """(lo, hi) of the layers mode's grey (N - lo) / (hi - lo); mirrors layer_grey in render.wgsl."""
+    if params.get("max_layers", 0) > 0:
+        return float(params.get("min_layers", 0)), float(params["max_layers"])
+    return 0.0, float(max(params.get("layers", 0), params.get("linear_steps", 0), 1))
 
 
 def _read_texture(device, texture, channels: int, dtype) -> np.ndarray:

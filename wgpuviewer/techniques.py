@@ -8,6 +8,7 @@ Parameters travel to WGSL in the ``TraceParams`` uniform, whose struct is genera
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from .errors import UserError
@@ -15,7 +16,13 @@ from .errors import UserError
 #: Fields of the WGSL ``TraceParams`` uniform (all f32, in this order). ``height_scale`` and the
 #: depth map's size in texels (for the mip level) come from the material; the rest are technique
 #: parameters (0 where a technique has no such parameter).
-TRACE_FIELDS = ("height_scale", "depth_width", "depth_height", "layers", "offset_limiting")
+TRACE_FIELDS = (
+    "height_scale", "depth_width", "depth_height", "layers", "offset_limiting",
+    "min_layers", "max_layers", "angle_only",  # pom_adaptive
+    "linear_steps", "binary_steps",  # relief
+    "max_steps",  # maxmip
+    "iterations", "cone_cos",  # distance, distance_refined (cone_cos: fixed by the map, see Technique.fixed)
+)
 
 #: Hard cap on any layer count, mirrored by ``MAX_LAYERS`` in the WGSL prelude.
 MAX_LAYERS = 1024
@@ -55,6 +62,8 @@ class Technique:
     params: tuple[Param, ...] = ()
     ray_search: bool = False
     wgsl: str = field(default="")
+    #: TraceParams values fixed by the technique (not user parameters), e.g. a property of the map it samples.
+    fixed: tuple[tuple[str, float], ...] = ()
 
     @property
     def wgsl_file(self) -> str:
@@ -73,6 +82,14 @@ class Technique:
     def defaults(self) -> dict:
         return {p.name: p.kind(p.default) for p in self.params}
 
+    def trace_values(self, params: dict) -> dict:
+        """What goes into the TraceParams uniform: the parameters plus the technique's fixed values."""
+        return {**dict(self.fixed), **params}
+
+
+#: The admissible view cone (half-angle from the normal, degrees) the refined distance map is built for
+#: (maps.py passes it to maptools' distance_refined kind); steeper rays get no refined steps (see distance.wgsl).
+REFINED_MAX_ANGLE = 80.0
 
 _LAYERS_DOC = "layer count: the ray is tested at this many evenly spaced depths (cap: MAX_LAYERS)"
 
@@ -110,6 +127,58 @@ TECHNIQUES: dict[str, Technique] = {
             "up to N+1 depth fetches", ("albedo", "normal", "depth"),
             (Param("layers", 16, 1, MAX_LAYERS, int, _LAYERS_DOC),),
             ray_search=True,
+        ),
+        Technique(
+            "pom_adaptive", "6",
+            "Adaptive POM (thesis): layer count from the view angle, F = (1-|V.z|)^0.8, and the complexity map C "
+            "at the entry uv: N = int(mix(mix(Nmin, Nmax/2, F), mix(Nmin, Nmax, F), C)) (truncated, as the "
+            "thesis' int()); then the POM search. angle_only: three.js/Godot's N = int(mix(Nmax, Nmin, |V.z|)).",
+            "up to N+1 depth fetches (+1 complexity fetch, not counted)", ("albedo", "normal", "depth", "complexity"),
+            (
+                Param("min_layers", 4, 1, MAX_LAYERS, int, "Nmin: layers at a head-on view"),
+                Param("max_layers", 32, 1, MAX_LAYERS, int, "Nmax: layers at a grazing view on a complex region"),
+                Param("angle_only", False, 0, 1, bool, "ignore the complexity map (three.js/Godot variant)"),
+            ),
+            ray_search=True,
+        ),
+        Technique(
+            "relief", "7",
+            "Relief mapping (Policarpo): linear search in equal depth steps, then binary search between the last "
+            "step above the surface and the first below it.",
+            "up to linear_steps+1+binary_steps depth fetches", ("albedo", "normal", "depth"),
+            (
+                Param("linear_steps", 16, 1, MAX_LAYERS, int, "linear search steps (depth layers)"),
+                Param("binary_steps", 6, 0, 32, int, "binary refinement steps (each halves the bracket)"),
+            ),
+            ray_search=True,
+        ),
+        Technique(
+            "maxmip", "8",
+            "Maximum-mipmap tracing (seed 004): descend a max pyramid over the bilinear cells from the top, skip "
+            "nodes the ray passes above, climb back after a skip; solve the exact per-cell quadratic at the base. "
+            "Finds the first hit of the bilinear surface to float32 precision (repeat addressing).",
+            "pyramid texel per node + one 2x2 gather per base cell", ("albedo", "normal", "depth", "maxmip"),
+            (Param("max_steps", 1024, 1, 65536, int, "cap on traversal steps (capped rays are flagged)"),),
+            ray_search=True,
+        ),
+        Technique(
+            "distance", "9",
+            "Distance-map parallax (Donnelly): sphere tracing through a 3D map of safe radii; where the radius is "
+            "0 the current bilinear cell is solved exactly and skipped if it holds no hit. Never passes a surface.",
+            "one volume fetch per step + one 2x2 gather per exact cell", ("albedo", "normal", "depth", "distance"),
+            (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
+            ray_search=True, fixed=(("cone_cos", -1.0),),
+        ),
+        Technique(
+            "distance_refined", "0",
+            "Distance-map parallax on the visibility-refined map (seed 000): the same tracer as distance "
+            "(distance.wgsl), the map stores longer safe steps for rays within the admissible view cone "
+            f"({REFINED_MAX_ANGLE:g} degrees); steeper rays take only exact cell steps.",
+            "one volume fetch per step + one 2x2 gather per exact cell",
+            ("albedo", "normal", "depth", "distance_refined"),
+            (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
+            ray_search=True, wgsl="distance.wgsl",
+            fixed=(("cone_cos", math.cos(math.radians(REFINED_MAX_ANGLE))),),
         ),
     )
 }

@@ -8,5 +8,5 @@ fn trace(uv: vec2f, v: vec3f, lod: f32) -> TraceResult {
     if limited {
         offset = v.xy * (d * trace_params.height_scale);
     }
-    return TraceResult(uv - offset, d, fetch_count, is_grazing(v) && !limited);
+    return TraceResult(uv - offset, d, fetch_count, is_grazing(v) && !limited, 0u);
 }

@@ -12,7 +12,7 @@ struct ProbeHit {
     depth: f32,
     fetches: u32,
     capped: u32,
-    _pad0: u32,
+    layers: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -28,5 +28,5 @@ fn probe_main(@builtin(global_invocation_id) id: vec3u, @builtin(num_workgroups)
         return;
     }
     let r = trace(rays[i].uv, rays[i].view.xyz, 0.0);
-    hits[i] = ProbeHit(r.uv, r.depth, r.fetches, u32(r.capped), 0u, 0u, 0u);
+    hits[i] = ProbeHit(r.uv, r.depth, r.fetches, u32(r.capped), r.layers, 0u, 0u);
 }

@@ -9,6 +9,7 @@ const MODE_COLOR: u32 = 0u;
 const MODE_COST: u32 = 1u;
 const MODE_UV: u32 = 2u;
 const MODE_DEPTH: u32 = 3u;
+const MODE_LAYERS: u32 = 4u;
 
 struct Light {
     vector: vec4f,  // w = 0: direction towards the light; w = 1: light position
@@ -114,6 +115,16 @@ fn heat(x: f32) -> vec3f {
     return clamp(vec3f(s, s - 1.0, s - 2.0), vec3f(0.0), vec3f(1.0));
 }
 
+// The thesis' debug view: layer count as grey, (N - Nmin) / (Nmax - Nmin) for techniques with a layer
+// range (pom_adaptive), N / layers for fixed layer counts; black for techniques without layers.
+// (renderer.layer_range computes the same range for offscreen pictures.)
+fn layer_grey(n: u32) -> f32 {
+    let ranged = trace_params.max_layers > 0.0;
+    let lo = select(0.0, trace_params.min_layers, ranged);
+    let hi = select(max(max(trace_params.layers, trace_params.linear_steps), 1.0), trace_params.max_layers, ranged);
+    return clamp((f32(n) - lo) / max(hi - lo, 1.0), 0.0, 1.0);
+}
+
 // Window/surface output: one target, the Frame.mode decides what is shown.
 @fragment
 fn fs_color(in: VertexOut) -> @location(0) vec4f {
@@ -122,6 +133,7 @@ fn fs_color(in: VertexOut) -> @location(0) vec4f {
         case MODE_COST: { return vec4f(heat(f32(s.hit.fetches) / frame.cost_scale), 1.0); }
         case MODE_UV: { return vec4f(fract(s.hit.uv), 0.0, 1.0); }
         case MODE_DEPTH: { return vec4f(vec3f(s.hit.depth), 1.0); }
+        case MODE_LAYERS: { return vec4f(vec3f(layer_grey(s.hit.layers)), 1.0); }
         default: { return vec4f(s.color, 1.0); }
     }
 }
@@ -131,6 +143,7 @@ struct DataOut {
     // hit u, hit v, hit depth, fetches (negative: capped), as float bits: float32 targets are not
     // renderable everywhere (OpenGL ES), 32-bit integer targets are.
     @location(1) data: vec4u,
+    @location(2) layers: u32,  // depth layers the search used (MODE_LAYERS / the `layers` output mode)
 }
 
 // Offscreen output: the shaded colour plus the raw trace data (uv/depth/cost modes, .npy files).
@@ -139,5 +152,5 @@ fn fs_data(in: VertexOut) -> DataOut {
     let s = shade(in);
     let fetches = f32(s.hit.fetches);
     let data = vec4f(s.hit.uv, s.hit.depth, select(fetches, -fetches - 1.0, s.hit.capped));
-    return DataOut(vec4f(s.color, 1.0), bitcast<vec4u>(data));
+    return DataOut(vec4f(s.color, 1.0), bitcast<vec4u>(data), s.hit.layers);
 }

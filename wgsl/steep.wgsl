@@ -14,5 +14,5 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
         uv -= duv;
         d = depth_at(uv, lod);
     }
-    return TraceResult(uv, f32(i) * layer_step, fetch_count, is_grazing(v));
+    return TraceResult(uv, f32(i) * layer_step, fetch_count, is_grazing(v), n);
 }
