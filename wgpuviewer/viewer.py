@@ -1,9 +1,14 @@
-"""The interactive window: rendercanvas (glfw) on any wgpu backend.
+"""The interactive window: rendercanvas (glfw by default, Qt on request) on any wgpu backend.
 
-Keys: 1-9 pick a technique of the scene, Left/Right cycle, WASD/QE fly, drag with the left mouse
-button to look around, R resets the camera, D toggles the cost view, Escape closes.
-Scripted runs (tests, demos): ``frames`` frames, ``keys`` pressed one per frame, the last frame saved
-to ``screenshot``.
+Compare relief-mapping techniques live: number keys and Left/Right switch techniques, B splits the
+screen between two of them (drag the divider), Shift+D shows the cost (depth fetches per pixel) and
+Shift+E the UV error against a high-layer-count POM reference, both as heat maps with a legend.
+A HUD (imgui) shows FPS/frame/GPU time, the technique's description and live parameters, and the
+keys (F1). Edited WGSL files are recompiled on the fly. Settings persist between sessions
+(``wgpuviewer.settings``). ``KEYS`` lists every key.
+
+Scripted runs (tests, demos): ``frames`` frames, ``keys`` pressed one per frame, the last frame
+(HUD included) saved to ``screenshot``; an ERROR logged while drawing makes the run exit 1.
 """
 
 from __future__ import annotations
@@ -15,6 +20,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import wgpu
 
 from .camera import normalize
 from .errors import UserError
@@ -22,16 +28,46 @@ from .gpu import get_gpu
 from .output import save_rgb_png
 from .renderer import DEPTH_FORMAT, Renderer
 from .scene import Camera, Scene
+from .settings import LIMITS, Settings, save_settings
+from .stats import FrameStats, GpuTimer
 
-MOVE_SPEED = 1.5  # scene units per second
-LOOK_SPEED = 0.005  # radians per pixel dragged
+MOVE_SPEED = 1.5  # scene units per second (default; settings.move_speed)
+LOOK_SPEED = 0.005  # radians per pixel dragged (default; settings.look_sensitivity)
+GUIS = ("glfw", "qt", "auto")
+MODES = ("color", "cost", "error")
+
+#: (keys, what they do): the help panel and the README.
+KEYS = (
+    ("1-9", "pick a technique (the active half in A/B)"),
+    ("Left/Right", "previous/next technique"),
+    ("W A S D Q E", "fly: forward, left, back, right, down, up"),
+    ("left drag", "look around (fly) / orbit (orbit)"),
+    ("wheel", "zoom (orbit) / move speed (fly)"),
+    ("O", "fly / orbit camera"),
+    ("R", "reset the camera"),
+    ("Shift+D", "cost heat map (depth fetches per pixel)"),
+    ("Shift+E", "error heat map (texels vs POM 512 layers)"),
+    ("M", "cycle colour / cost / error"),
+    ("B", "A/B split view (drag the divider)"),
+    ("Tab", "switch the active half (A/B)"),
+    ("P", "save a screenshot PNG"),
+    ("C", "reset the statistics"),
+    ("X", "show/hide the statistics"),
+    ("H", "hide/show all UI"),
+    ("F1", "show/hide this help"),
+    ("V", "vsync on/off"),
+    ("F11", "fullscreen on/off"),
+    ("F5", "reload the shaders now"),
+    ("Esc", "quit"),
+)
 
 
 class FlyCamera:
     """Position + yaw/pitch, started from (and reset to) the scene's camera."""
 
-    def __init__(self, camera: Camera):
+    def __init__(self, camera: Camera, sensitivity: float = LOOK_SPEED):
         self.start = camera
+        self.sensitivity = sensitivity
         self.reset()
 
     def reset(self):
@@ -47,8 +83,8 @@ class FlyCamera:
         return np.array([np.sin(self.yaw) * cp, np.sin(self.pitch), -np.cos(self.yaw) * cp])
 
     def look(self, dx: float, dy: float):
-        self.yaw += dx * LOOK_SPEED
-        self.pitch = float(np.clip(self.pitch - dy * LOOK_SPEED, -1.55, 1.55))
+        self.yaw += dx * self.sensitivity
+        self.pitch = float(np.clip(self.pitch - dy * self.sensitivity, -1.55, 1.55))
 
     def move(self, right: float, up: float, forward: float):
         f = self.forward
@@ -60,18 +96,87 @@ class FlyCamera:
         return replace(self.start, position=tuple(p), target=tuple(p + self.forward), up=(0.0, 1.0, 0.0))
 
 
+class OrbitCamera:
+    """Orbits the scene camera's target: drag turns, the wheel zooms (distance factor per step)."""
+
+    MIN_DISTANCE = 0.05
+
+    def __init__(self, camera: Camera, sensitivity: float = LOOK_SPEED, zoom: float = 0.1):
+        self.start = camera
+        self.sensitivity = sensitivity
+        self.zoom_step = zoom
+        self.reset()
+
+    def reset(self):
+        c = self.start
+        self.target = np.asarray(c.target, np.float64)
+        offset = np.asarray(c.position, np.float64) - self.target
+        self.distance = max(float(np.linalg.norm(offset)), self.MIN_DISTANCE)
+        d = offset / self.distance if np.linalg.norm(offset) > 0 else np.array([0.0, 0.0, 1.0])
+        self.yaw = float(np.arctan2(d[0], d[2]))
+        self.pitch = float(np.arcsin(np.clip(d[1], -1.0, 1.0)))
+
+    def look(self, dx: float, dy: float):
+        self.yaw -= dx * self.sensitivity
+        self.pitch = float(np.clip(self.pitch + dy * self.sensitivity, -1.55, 1.55))
+
+    def zoom(self, steps: float):
+        """Positive steps move away, negative closer (multiplicative, never through the target)."""
+        self.distance = float(
+            np.clip(self.distance * (1.0 + self.zoom_step) ** steps, self.MIN_DISTANCE, self.start.far * 0.9)
+        )
+
+    @property
+    def position(self) -> np.ndarray:
+        cp = np.cos(self.pitch)
+        return self.target + self.distance * np.array([np.sin(self.yaw) * cp, np.sin(self.pitch), np.cos(self.yaw) * cp])
+
+    def camera(self) -> Camera:
+        return replace(self.start, position=tuple(self.position), target=tuple(self.target), up=(0.0, 1.0, 0.0))
+
+
 _MOVE_KEYS = {"w": (0, 0, 1), "s": (0, 0, -1), "a": (-1, 0, 0), "d_move": (1, 0, 0), "e": (0, 1, 0), "q": (0, -1, 0)}
 
 
-class Viewer:
-    def __init__(self, scene: Scene, technique: str, backend: str | None):
-        try:
+def _canvas_class(gui: str):
+    try:
+        if gui == "glfw":
             from rendercanvas.glfw import RenderCanvas, loop
-        except ImportError as error:
-            raise UserError(
-                f"the window needs glfw ({error}); install it with: pip install 'wgpuviewer[window]'"
-            ) from None
-        self.loop = loop
+        elif gui == "qt":
+            import importlib
+
+            for qt in ("PySide6", "PyQt6", "PySide2", "PyQt5"):  # rendercanvas.qt uses the one imported
+                try:
+                    importlib.import_module(f"{qt}.QtWidgets")
+                    break
+                except ImportError:
+                    continue
+            from rendercanvas.qt import RenderCanvas, loop
+        else:
+            from rendercanvas.auto import RenderCanvas, loop
+    except ImportError as error:
+        fix = {"glfw": "pip install 'wgpuviewer[window]'", "qt": "pip install PySide6"}.get(gui, "pip install glfw")
+        raise UserError(f"--gui {gui}: the window toolkit is missing ({error}); install it with: {fix}") from None
+    return RenderCanvas, loop
+
+
+class Viewer:
+    def __init__(
+        self,
+        scene: Scene,
+        technique: str,
+        backend: str | None,
+        *,
+        gui: str = "glfw",
+        settings: Settings | None = None,
+        size: tuple[int, int] | None = None,
+        hud: bool = True,
+        scripted: bool = False,
+    ):
+        RenderCanvas, self.loop = _canvas_class(gui)
+        self.gui = gui
+        self.settings = settings or Settings()
+        s = self.settings
         self.scene = scene
         self.gpu = get_gpu(backend)
         self.renderer = Renderer(scene, self.gpu)
@@ -79,21 +184,173 @@ class Viewer:
         if technique not in self.techniques:
             self.techniques.append(technique)
         self.technique = technique
+        self.technique_b = self.techniques[(self.techniques.index(technique) + 1) % len(self.techniques)]
+        self.active_side = "A"
+        self.split = False
+        self.split_x = 0.5
         self.mode = "color"
-        self.fly = FlyCamera(scene.camera)
+        self.camera_mode = s.camera_mode
+        self.fly = FlyCamera(scene.camera, s.look_sensitivity)
+        self.orbit = OrbitCamera(scene.camera, s.look_sensitivity, s.zoom_sensitivity)
+        self.move_speed = s.move_speed
+        self.show_hud, self.show_stats, self.show_help = s.show_hud, s.show_stats, False
+        self.vsync = s.vsync and not scripted  # scripted runs draw as fast as they can
+        self.fullscreen = False
+        self.messages: list[str] = []
+        self.error_range = 2.0
+        self.error_texels = (1, 1)
         self.held: set[str] = set()
         self.drag_from: tuple[float, float] | None = None
-        self.canvas = RenderCanvas(title="wgpuviewer", size=(1280, 720), update_mode="continuous", max_fps=60)
+        self.dragging_divider = False
+        self.frame_size = (0, 0)
+        self.scripted = scripted
+        width, height = size or (s.width, s.height)
+        self.canvas = RenderCanvas(
+            title="wgpuviewer", size=(width, height), update_mode="continuous",
+            max_fps=1000 if scripted else 240, vsync=self.vsync,
+        )
         self.context = self.canvas.get_wgpu_context()
         self.format = self.context.get_preferred_format(self.gpu.adapter)
-        # COPY_SRC lets a scripted run read back the frame it just drew.
-        self.context.configure(device=self.gpu.device, format=self.format, usage="RENDER_ATTACHMENT|COPY_SRC")
+        self._configure()
         self._depth = None
         self._last_time = time.perf_counter()
+        self.stats = FrameStats()
+        self.timer = GpuTimer(self.gpu.device) if GpuTimer.available(self.gpu) else None
+        from .shader_reload import ShaderReloader
+
+        self.reloader = ShaderReloader(self.renderer)
+        self._shown_errors: list[str] = []
+        self._error = None  # ErrorOverlay, built on first use
+        self._error_key = None
+        self._error_time = -1e9
+        from . import hud as hud_module
+
+        self.hud = hud_module.Hud(self) if hud and hud_module.AVAILABLE else None
+        if hud and self.hud is None:
+            self.message("no HUD: install imgui-bundle (pip install 'wgpuviewer[window]')")
         self.canvas.add_event_handler(self.on_key_down, "key_down")
         self.canvas.add_event_handler(self.on_key_up, "key_up")
         self.canvas.add_event_handler(self.on_pointer, "pointer_down", "pointer_up", "pointer_move")
+        self.canvas.add_event_handler(self.on_wheel, "wheel")
+        if s.fullscreen:
+            self.set_fullscreen(True)
         self._update_title()
+
+    def _configure(self):
+        # COPY_SRC lets scripted runs and P read back the frame just drawn.
+        self.context.configure(device=self.gpu.device, format=self.format, usage="RENDER_ATTACHMENT|COPY_SRC")
+
+    # --- state changes (keys and HUD) ----------------------------------------------------------
+
+    def message(self, text: str):
+        self.messages.append(text)
+        print(text, file=sys.stderr)
+
+    @property
+    def cam(self):
+        return self.orbit if self.camera_mode == "orbit" else self.fly
+
+    @property
+    def look_sensitivity(self) -> float:
+        return self.fly.sensitivity
+
+    @look_sensitivity.setter
+    def look_sensitivity(self, value: float):
+        self.fly.sensitivity = self.orbit.sensitivity = float(value)
+
+    def set_mode(self, mode: str):
+        self.mode = mode
+        self._error_key = None
+        self._update_title()
+
+    def toggle_mode(self, mode: str):
+        self.set_mode("color" if self.mode == mode else mode)
+
+    def set_camera_mode(self, mode: str):
+        if mode == self.camera_mode:
+            return
+        # Keep the view: the new camera starts where the old one looks from.
+        current = self.cam.camera()
+        if mode == "orbit":
+            self.orbit.start = replace(self.scene.camera, position=current.position,
+                                       target=self.orbit.target if np.isfinite(self.orbit.target).all()
+                                       else self.scene.camera.target)
+            self.orbit.reset()
+            self.orbit.start = self.scene.camera
+        else:
+            self.fly.position = np.asarray(current.position, np.float64)
+            f = normalize(np.subtract(current.target, current.position))
+            self.fly.yaw = float(np.arctan2(f[0], -f[2]))
+            self.fly.pitch = float(np.arcsin(np.clip(f[1], -1.0, 1.0)))
+        self.camera_mode = mode
+
+    def set_technique(self, name: str):
+        if self.split and self.active_side == "B":
+            self.technique_b = name
+        else:
+            self.technique = name
+        self._update_title()
+
+    def set_vsync(self, on: bool):
+        """Vsync picks the surface present mode (fifo vs immediate/mailbox); it needs a reconfigure."""
+        self.vsync = bool(on)
+        try:
+            self.canvas._vsync = self.vsync  # read by rendercanvas when it creates the surface
+            inner = getattr(self.context, "_wgpu_context", None)
+            if inner is not None:
+                inner._present_info["vsync"] = self.vsync
+            self._configure()
+        except Exception as error:  # noqa: BLE001 -- private hooks of rendercanvas/wgpu may move
+            self.message(f"vsync: could not change the present mode ({error})")
+        self.message(f"vsync {'on' if self.vsync else 'off'}")
+
+    def set_fullscreen(self, on: bool):
+        try:
+            if self.gui == "qt" or hasattr(self.canvas, "showFullScreen"):
+                self.canvas.showFullScreen() if on else self.canvas.showNormal()
+            else:
+                import glfw
+
+                window = self.canvas._window
+                if on:
+                    self._windowed = (glfw.get_window_pos(window), glfw.get_window_size(window))
+                    monitor = glfw.get_primary_monitor()
+                    mode = glfw.get_video_mode(monitor)
+                    glfw.set_window_monitor(window, monitor, 0, 0, mode.size.width, mode.size.height,
+                                            mode.refresh_rate)
+                else:
+                    (x, y), (w, h) = getattr(self, "_windowed", ((100, 100), (self.settings.width, self.settings.height)))
+                    glfw.set_window_monitor(window, None, x, y, w, h, 0)
+            self.fullscreen = on
+        except Exception as error:  # noqa: BLE001 -- e.g. no monitor, or another toolkit
+            self.message(f"fullscreen: not available here ({error})")
+
+    def screenshot(self, texture) -> Path:
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        name = f"wgpuviewer-{Path(self.scene.path).stem if self.scene.path else 'scene'}-{self.technique}-{stamp}.png"
+        path = Path.cwd() / name
+        save_rgb_png(path, self.read_frame(texture))
+        self.message(f"screenshot: {path}")
+        return path
+
+    def reset_stats(self):
+        self.stats.reset()
+
+    def cost_scale(self) -> float:
+        params = self.renderer.params.get(self.technique) or {}
+        return float(params.get("layers", 1)) + 2.0
+
+    def material_height_scales(self) -> str:
+        return ", ".join(f"{m.height_scale:g}" for m in self.scene.materials.values())
+
+    def material_height_scale(self) -> float:
+        return float(next(iter(self.scene.materials.values())).height_scale)
+
+    @property
+    def error_reference(self) -> str:
+        from .error_view import REFERENCE, REFERENCE_LAYERS
+
+        return f"{REFERENCE} {REFERENCE_LAYERS} layers"
 
     # --- input -------------------------------------------------------------------------------
 
@@ -101,23 +358,50 @@ class Viewer:
         """What a key does (also used by scripted runs)."""
         lower = key.lower()
         if key.isdigit() and 1 <= int(key) <= len(self.techniques):
-            self.technique = self.techniques[int(key) - 1]
+            self.set_technique(self.techniques[int(key) - 1])
         elif key in ("ArrowRight", "ArrowLeft"):
             step = 1 if key == "ArrowRight" else -1
-            self.technique = self.techniques[(self.techniques.index(self.technique) + step) % len(self.techniques)]
+            current = self.technique_b if self.split and self.active_side == "B" else self.technique
+            self.set_technique(self.techniques[(self.techniques.index(current) + step) % len(self.techniques)])
         elif lower == "r":
-            self.fly.reset()
+            self.cam.reset()
         elif key == "D":  # shift+d; plain d strafes
-            self.mode = "cost" if self.mode == "color" else "color"
+            self.toggle_mode("cost")
+        elif key == "E":  # shift+e; plain e flies up
+            self.toggle_mode("error")
+        elif lower == "m":
+            self.set_mode(MODES[(MODES.index(self.mode) + 1) % len(MODES)])
+        elif lower == "b":
+            self.split = not self.split
+            self.active_side = "A"
+        elif key == "Tab":
+            self.active_side = "B" if self.active_side == "A" and self.split else "A"
+        elif lower == "o":
+            self.set_camera_mode("fly" if self.camera_mode == "orbit" else "orbit")
+        elif lower == "h":
+            self.show_hud = not self.show_hud
+        elif lower == "x":
+            self.show_stats = not self.show_stats
+        elif lower == "c":
+            self.reset_stats()
+        elif key == "F1":
+            self.show_help = not self.show_help
+        elif lower == "p":
+            self._want_screenshot = True
+        elif lower == "v":
+            self.set_vsync(not self.vsync)
+        elif key == "F11":
+            self.set_fullscreen(not self.fullscreen)
+        elif key == "F5":
+            self.reloader.reload()
         elif key == "Escape":
             self.canvas.close()
         self._update_title()
 
     def on_key_down(self, event):
         key = event["key"]
-        lower = key.lower()
-        if lower in "wsaeq" and len(lower) == 1:
-            self.held.add(lower)
+        if key in ("w", "s", "a", "e", "q"):
+            self.held.add(key)
         elif key == "d":
             self.held.add("d_move")
         else:
@@ -127,45 +411,137 @@ class Viewer:
         key = event["key"].lower()
         self.held.discard("d_move" if key == "d" else key)
 
+    def _divider_hit(self, x: float) -> bool:
+        width = self.canvas.get_logical_size()[0]
+        return self.split and abs(x - self.split_x * width) <= 8
+
     def on_pointer(self, event):
         kind = event["event_type"]
         if kind == "pointer_down" and event["button"] == 1:
-            self.drag_from = (event["x"], event["y"])
+            if self._divider_hit(event["x"]):
+                self.dragging_divider = True
+            else:
+                self.drag_from = (event["x"], event["y"])
         elif kind == "pointer_up":
             self.drag_from = None
-        elif kind == "pointer_move" and self.drag_from is not None:
-            self.fly.look(event["x"] - self.drag_from[0], event["y"] - self.drag_from[1])
-            self.drag_from = (event["x"], event["y"])
+            self.dragging_divider = False
+        elif kind == "pointer_move":
+            if self.dragging_divider:
+                width = max(self.canvas.get_logical_size()[0], 1)
+                self.split_x = float(np.clip(event["x"] / width, 0.02, 0.98))
+            elif self.drag_from is not None:
+                self.cam.look(event["x"] - self.drag_from[0], event["y"] - self.drag_from[1])
+                self.drag_from = (event["x"], event["y"])
+
+    def on_wheel(self, event):
+        steps = event["dy"] / 100.0
+        if self.camera_mode == "orbit":
+            self.orbit.zoom(steps)
+        else:
+            lo, hi = LIMITS["move_speed"]
+            self.move_speed = float(np.clip(self.move_speed * 1.1 ** (-steps), lo, hi))
 
     def _update_title(self):
-        self.canvas.set_title(f"wgpuviewer - {self.scene.name} - {self.technique} ({self.mode})")
+        what = f"{self.technique} | {self.technique_b}" if self.split else self.technique
+        self.canvas.set_title(f"wgpuviewer - {self.scene.name} - {what} ({self.mode})")
 
     # --- frames ------------------------------------------------------------------------------
 
-    def draw(self) -> np.ndarray | None:
+    def _scene_passes(self, w: int, h: int, camera: Camera) -> list:
+        """(technique, scissor) of the passes that draw the scene: one, or the two halves of A/B."""
+        if not self.split:
+            return [(self.technique, None)]
+        xs = int(np.clip(round(self.split_x * w), 1, w - 1)) if w > 1 else 1
+        return [(self.technique, (0, 0, xs, h)), (self.technique_b, (xs, 0, w - xs, h))]
+
+    def _update_error_view(self, w: int, h: int, camera: Camera, now: float):
+        """Recompute the error map when what it shows changed (at most ~3 times a second)."""
+        from . import error_view
+
+        size = error_view.map_size((w, h))
+        techniques = (self.technique, self.technique_b) if self.split else (self.technique,)
+        key = (
+            size, techniques, self.split and round(self.split_x, 3), camera,
+            repr([self.renderer.params.get(t) for t in techniques]),
+        )
+        if key == self._error_key or (self._error_key is not None and now - self._error_time < 0.3):
+            return
+        if self._error is None:
+            self._error = error_view.ErrorOverlay(self.gpu.device, self.format)
+        reference = error_view.reference_render(self.renderer, size, camera)
+        values = error_view.error_map(self.renderer, techniques[0], size, camera, reference)
+        if self.split:
+            right = error_view.error_map(self.renderer, techniques[1], size, camera, reference)
+            xs = int(round(self.split_x * size[0]))
+            values[:, xs:] = right[:, xs:]
+        self.error_texels = error_view.texel_size(self.renderer)
+        self._error.upload(values)
+        self._error_key, self._error_time = key, now
+
+    def draw(self):
         now = time.perf_counter()
         dt, self._last_time = min(now - self._last_time, 0.1), now
-        if self.held:
-            step = np.sum([_MOVE_KEYS[k] for k in self.held], axis=0) * MOVE_SPEED * dt
+        self.stats.tick(now)
+        if self.timer:
+            for ms in self.timer.collect():
+                self.stats.add_gpu_time(ms)
+        self.reloader.poll(now)
+        if self.reloader.errors != self._shown_errors:  # new compile errors (or fixed ones): say so once
+            self._shown_errors = list(self.reloader.errors)
+            for error in self._shown_errors:
+                print(f"shader error: {error}", file=sys.stderr)
+            if not self._shown_errors:
+                self.message("shaders reloaded")
+        if self.held and self.camera_mode == "fly":
+            step = np.sum([_MOVE_KEYS[k] for k in self.held], axis=0) * self.move_speed * dt
             self.fly.move(*step)
         texture = self.context.get_current_texture()
         w, h = texture.size[:2]
+        if w < 1 or h < 1:
+            raise wgpu.DrawCancelled("zero-sized frame")
+        self.frame_size = (w, h)
         device = self.gpu.device
         if self._depth is None or self._depth.size[:2] != (w, h):
             self._depth = device.create_texture(
                 label="window:depth", size=(w, h, 1), format=DEPTH_FORMAT, usage="RENDER_ATTACHMENT"
             )
-        encoder = device.create_command_encoder(label="window")
-        self.renderer.encode(
-            encoder, [texture.create_view()], self._depth.create_view(), (self.format,),
-            self.technique, self.fly.camera(), (w, h), self.mode,
-        )
+        camera = self.cam.camera()
+        if self.mode == "error":
+            self._update_error_view(w, h, camera, now)
+        view = texture.create_view()
+        scene_mode = "cost" if self.mode == "cost" else "color"
+        passes = self._scene_passes(w, h, camera)
+        if self.timer:
+            self.timer.begin_frame()
+        # One submit per scene pass: each pass writes the renderer's frame/params uniforms first.
+        for i, (technique, scissor) in enumerate(passes):
+            encoder = device.create_command_encoder(label="window")
+            writes = self.timer.writes(i == 0, i == len(passes) - 1) if self.timer else None
+            self.renderer.encode(
+                encoder, [view], self._depth.create_view(), (self.format,), technique, camera, (w, h),
+                scene_mode, clear=(i == 0), scissor=scissor, timestamp_writes=writes,
+            )
+            if self.timer and i == len(passes) - 1:
+                self.timer.encode_resolve(encoder)
+            device.queue.submit([encoder.finish()])
+        if self.timer:
+            self.timer.after_submit()
+        encoder = device.create_command_encoder(label="window:overlay")
+        if self.mode == "error" and self._error is not None:
+            self._error.encode(encoder, view, (0, 0, w, h), self.error_range)
+        if getattr(self, "_want_screenshot", False):  # the scene without the HUD
+            self._want_screenshot = False
+            device.queue.submit([encoder.finish()])
+            self.screenshot(texture)
+            encoder = device.create_command_encoder(label="window:hud")
+        if self.hud is not None:
+            self.hud.encode(encoder, view)
         device.queue.submit([encoder.finish()])
         return texture
 
     def read_frame(self, texture) -> np.ndarray:
         w, h = texture.size[:2]
-        raw = self.gpu.device.queue.read_texture(
+        raw = self.gpu.device.queue.read_texture(  # wgpu-py pads the rows to 256 bytes itself
             {"texture": texture, "mip_level": 0, "origin": (0, 0, 0)},
             {"offset": 0, "bytes_per_row": w * 4, "rows_per_image": h},
             (w, h, 1),
@@ -173,6 +549,22 @@ class Viewer:
         pixels = np.frombuffer(raw, np.uint8).reshape(h, w, 4)
         rgb = pixels[:, :, [2, 1, 0]] if self.format.startswith("bgra") else pixels[:, :, :3]
         return np.ascontiguousarray(rgb)
+
+    def current_settings(self) -> Settings:
+        """What to persist: window size (when not fullscreen), camera and UI choices, scene, technique."""
+        s = self.settings
+        if not self.fullscreen:
+            lw, lh = self.canvas.get_logical_size()
+            if lw >= LIMITS["width"][0] and lh >= LIMITS["height"][0]:
+                s = replace(s, width=int(round(lw)), height=int(round(lh)))
+        lo, hi = LIMITS["look_sensitivity"]
+        return replace(
+            s, fullscreen=self.fullscreen, vsync=self.vsync, camera_mode=self.camera_mode,
+            move_speed=float(np.clip(self.move_speed, *LIMITS["move_speed"])),
+            look_sensitivity=float(np.clip(self.look_sensitivity, lo, hi)),
+            show_hud=self.show_hud, show_stats=self.show_stats,
+            last_scene=str(self.scene.path) if self.scene.path else "", last_technique=self.technique,
+        )
 
     def run(self, frames: int | None = None, screenshot: str | None = None, keys: list[str] = ()) -> int:
         state = {"frame": 0}
@@ -215,17 +607,27 @@ class _ErrorLogCounter(logging.Handler):
         self.count += 1
 
 
-def run_viewer(scene: Scene, technique: str, *, backend=None, frames=None, screenshot=None, keys=()) -> int:
+def run_viewer(
+    scene: Scene, technique: str, *, backend=None, frames=None, screenshot=None, keys=(),
+    gui: str = "glfw", settings: Settings | None = None, size=None, save: bool | None = None,
+) -> int:
+    """Open the window. Interactive runs save the settings on exit (``save``); scripted ones don't."""
     if frames is not None and frames < 1:
         raise UserError(f"--frames {frames}: expected a positive number of frames")
     if screenshot and frames is None:
         frames = max(len(keys), 0) + 3  # a screenshot implies a scripted run
     if screenshot and not screenshot.lower().endswith(".png"):
         raise UserError(f"--screenshot {screenshot}: expected a .png path")
-    viewer = Viewer(scene, technique, backend)
-    print(
-        "keys: 1-9 technique, Left/Right cycle, WASD/QE move, drag to look, R reset camera, "
-        "Shift+D cost view, Esc quit",
-        file=sys.stderr,
-    )
-    return viewer.run(frames, screenshot, keys)
+    scripted = frames is not None
+    viewer = Viewer(scene, technique, backend, gui=gui, settings=settings, size=size, scripted=scripted)
+    if not scripted:
+        print("keys: F1 help, 1-9 technique, B A/B split, Shift+D cost, Shift+E error, H hide UI, Esc quit",
+              file=sys.stderr)
+    code = viewer.run(frames, screenshot, keys)
+    if save if save is not None else not scripted:
+        try:
+            path = save_settings(viewer.current_settings())
+            print(f"settings saved to {path}", file=sys.stderr)
+        except OSError as error:
+            print(f"wgpuviewer: warning: could not save settings ({error})", file=sys.stderr)
+    return code

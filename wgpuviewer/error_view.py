@@ -1,0 +1,154 @@
+"""The viewer's error view: per-pixel UV error of a technique against a reference, as a heat map.
+
+Both the technique and the reference (POM at ``REFERENCE_LAYERS`` layers: with that many layers
+and the linear refinement its hit is, at viewer resolutions, indistinguishable from the float64
+exact hit) are rendered offscreen at reduced resolution with the same camera; the wrap-aware texel
+distance of their hit UVs (``reference.uv_error_texels``) goes into an r32float texture that a
+small fullscreen pipeline of our own paints over the frame with the cost view's heat colours.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import wgpu
+
+from .reference import uv_error_texels
+from .renderer import Renderer
+
+REFERENCE = "pom"
+REFERENCE_LAYERS = 512
+MAX_WIDTH = 400  # error maps are computed at most this wide (offscreen renders + a CPU readback)
+
+BLIT_WGSL = """
+struct Blit {
+    rect: vec4f,      // x, y, w, h of the viewport part in pixels (scissor)
+    max_value: f32,   // value shown as full heat
+    _pad0: f32, _pad1: f32, _pad2: f32,
+}
+@group(0) @binding(0) var<uniform> blit: Blit;
+@group(0) @binding(1) var values: texture_2d<f32>;
+
+@vertex
+fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
+    let p = vec2f(f32((i << 1u) & 2u), f32(i & 2u));  // fullscreen triangle
+    return vec4f(p * 2.0 - 1.0, 0.0, 1.0);
+}
+
+fn heat(x: f32) -> vec3f {  // same ramp as render.wgsl's cost view: black, red, yellow, white
+    let s = clamp(x, 0.0, 1.0) * 3.0;
+    return clamp(vec3f(s, s - 1.0, s - 2.0), vec3f(0.0), vec3f(1.0));
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    let size = vec2f(textureDimensions(values));
+    let frame = vec2f(blit.rect.z, blit.rect.w);
+    let texel = vec2i(clamp((pos.xy - blit.rect.xy) / frame * size, vec2f(0.0), size - 1.0));
+    let value = textureLoad(values, texel, 0).r;
+    if (value < 0.0) { discard; }  // nothing drawn there: keep the frame underneath
+    return vec4f(heat(value / blit.max_value), 1.0);
+}
+"""
+
+
+def map_size(window: tuple[int, int]) -> tuple[int, int]:
+    w, h = window
+    scale = min(1.0, MAX_WIDTH / max(w, 1))
+    return max(1, round(w * scale)), max(1, round(h * scale))
+
+
+def texel_size(renderer: Renderer) -> tuple[int, int]:
+    """(W, H) of the largest depth map of the scene: UV errors are measured in its texels."""
+    sizes = [renderer._texture(name, "depth").size[:2] for name in sorted({o.material for o in renderer.scene.objects})]
+    return max(sizes, key=lambda s: s[0] * s[1])
+
+
+def reference_render(renderer: Renderer, size, camera):
+    """Offscreen render of the reference technique (its parameters swapped in for the call)."""
+    saved = renderer.params.get(REFERENCE)
+    renderer.params[REFERENCE] = {**(saved or {}), "layers": REFERENCE_LAYERS}
+    renderer.params[REFERENCE].pop("height_scale", None)
+    if saved and "height_scale" in saved:  # a live height-scale override applies to the reference too
+        renderer.params[REFERENCE]["height_scale"] = saved["height_scale"]
+    try:
+        return renderer.render(REFERENCE, size, camera)
+    finally:
+        if saved is None:
+            renderer.params.pop(REFERENCE, None)
+        else:
+            renderer.params[REFERENCE] = saved
+
+
+def error_map(renderer: Renderer, technique: str, size, camera, reference=None) -> np.ndarray:
+    """(H, W) float32 UV error in texels; -1 where nothing was drawn. ``reference``: a render to reuse."""
+    ref = reference if reference is not None else reference_render(renderer, size, camera)
+    img = renderer.render(technique, size, camera)
+    covered = img.covered & ref.covered
+    err = np.full(covered.shape, -1.0, np.float32)
+    if covered.any():
+        err[covered] = uv_error_texels(img.data[covered][:, :2], ref.data[covered][:, :2], texel_size(renderer))
+    return err
+
+
+class ErrorOverlay:
+    """An r32float value texture painted as heat over (part of) the frame."""
+
+    def __init__(self, device: wgpu.GPUDevice, target_format: str):
+        self.device = device
+        module = device.create_shader_module(label="error-view", code=BLIT_WGSL)
+        F = wgpu.ShaderStage.FRAGMENT
+        self.layout = device.create_bind_group_layout(
+            label="error-view",
+            entries=[
+                {"binding": 0, "visibility": F, "buffer": {"type": "uniform"}},
+                {"binding": 1, "visibility": F, "texture": {"sample_type": "unfilterable-float"}},
+            ],
+        )
+        self.pipeline = device.create_render_pipeline(
+            label="error-view",
+            layout=device.create_pipeline_layout(label="error-view", bind_group_layouts=[self.layout]),
+            vertex={"module": module, "entry_point": "vs_main"},
+            primitive={"topology": "triangle-list"},
+            fragment={"module": module, "entry_point": "fs_main", "targets": [{"format": target_format}]},
+        )
+        self.texture = None
+        self.group = None
+        self.uniform = device.create_buffer(
+            label="error-view", size=32, usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST
+        )
+
+    def upload(self, values: np.ndarray) -> None:
+        h, w = values.shape
+        if self.texture is None or self.texture.size[:2] != (w, h):
+            self.texture = self.device.create_texture(
+                label="error-view", size=(w, h, 1), format="r32float",
+                usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
+            )
+            self.group = self.device.create_bind_group(
+                layout=self.layout,
+                entries=[
+                    {"binding": 0, "resource": {"buffer": self.uniform}},
+                    {"binding": 1, "resource": self.texture.create_view()},
+                ],
+            )
+        self.device.queue.write_texture(
+            {"texture": self.texture}, np.ascontiguousarray(values, np.float32),
+            {"bytes_per_row": 4 * w, "rows_per_image": h}, (w, h, 1),
+        )
+
+    def encode(self, encoder, view, rect: tuple[int, int, int, int], max_value: float) -> None:
+        """Paint over ``rect`` (x, y, w, h in target pixels) of ``view``; the texture spans the rect."""
+        if self.group is None:
+            return
+        self.device.queue.write_buffer(
+            self.uniform, 0, np.array([*rect, max(max_value, 1e-6), 0, 0, 0], np.float32).tobytes()
+        )
+        rpass = encoder.begin_render_pass(
+            label="error-view",
+            color_attachments=[{"view": view, "load_op": "load", "store_op": "store"}],
+        )
+        rpass.set_scissor_rect(*rect)
+        rpass.set_pipeline(self.pipeline)
+        rpass.set_bind_group(0, self.group)
+        rpass.draw(3)
+        rpass.end()
