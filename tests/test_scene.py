@@ -72,7 +72,7 @@ def error(tmp_path: Path, text: str, *parts: str) -> str:
 def test_default_scene():
     scene = load_scene(default_scene_path())
     assert default_scene_path().read_bytes() == (SCENES / "default.toml").read_bytes()
-    assert scene.techniques == ("basic", "normal", "parallax", "steep", "pom")
+    assert scene.techniques == ("basic", "normal", "parallax", "steep", "pom", "pom_adaptive", "relief", "maxmip")
     assert scene.technique == "pom"
     assert scene.technique_params["pom"] == {"layers": 32}
     assert scene.technique_params["steep"] == {"layers": 32}
@@ -400,3 +400,8 @@ def test_load_scene_file_problems(tmp_path):
     (tmp_path / "latin1.toml").write_bytes("name = 'caf\xe9'".encode("latin-1"))
     with pytest.raises(UserError, match=r"latin1\.toml: not UTF-8"):
         load_scene(tmp_path / "latin1.toml")
+
+
+def test_all_techniques_scene_lists_the_whole_registry():
+    scene = load_scene(SCENES / "all_techniques.toml")
+    assert scene.techniques == tuple(TECHNIQUES)

@@ -357,8 +357,8 @@ class Viewer:
     def press(self, key: str):
         """What a key does (also used by scripted runs)."""
         lower = key.lower()
-        if key.isdigit() and 1 <= int(key) <= len(self.techniques):
-            self.set_technique(self.techniques[int(key) - 1])
+        if key.isdigit() and (int(key) or 10) <= len(self.techniques):  # keys 1..9, then 0 for the 10th
+            self.set_technique(self.techniques[(int(key) or 10) - 1])
         elif key in ("ArrowRight", "ArrowLeft"):
             step = 1 if key == "ArrowRight" else -1
             current = self.technique_b if self.split and self.active_side == "B" else self.technique
