@@ -9,6 +9,7 @@ from pathlib import Path
 
 from .errors import UserError
 from .gpu import BACKEND_CHOICES, BACKEND_ENV
+from .output import OUTPUT_MODES
 
 DEFAULT_SIZE = (1280, 720)
 
@@ -59,9 +60,22 @@ def cmd_render(args) -> int:
 
 
 def cmd_view(args) -> int:
-    scene = load_scene_arg(args.scene)
-    technique = pick_technique(scene, args.technique)
-    if not has_display():
+    from .settings import load_settings
+
+    scripted = args.frames is not None or bool(args.screenshot)
+    settings, _warnings = load_settings()  # corrupt/outdated file: defaults + a warning on stderr
+    scene_arg, technique_arg = args.scene, args.technique
+    window = has_display()
+    if window and not scripted and scene_arg is None and settings.last_scene and Path(settings.last_scene).is_file():
+        scene_arg = settings.last_scene  # interactive runs continue where the last one ended
+        print(f"opening the last scene {scene_arg} (give a SCENE to open another)", file=sys.stderr)
+    scene = load_scene_arg(scene_arg)
+    if window and not scripted and technique_arg is None and scene_arg == settings.last_scene \
+            and settings.last_technique in scene.techniques:
+        technique_arg = settings.last_technique
+    technique = pick_technique(scene, technique_arg)
+    size = parse_size(args.size) if args.size else None
+    if not window:
         from .gpu import get_gpu
         from .output import save_output
         from .renderer import Renderer
@@ -69,13 +83,16 @@ def cmd_view(args) -> int:
         out = Path("out") / f"{Path(scene.path).stem if scene.path else 'scene'}_{technique}.png"
         print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the scene to {out} instead")
         renderer = Renderer(scene, get_gpu(args.backend))
-        save_output(out, renderer.render(technique, DEFAULT_SIZE), "color")
+        save_output(out, renderer.render(technique, size or DEFAULT_SIZE), "color")
         print(out)
         return 0
     from .viewer import run_viewer
 
     keys = [k for k in args.keys.split(",") if k] if args.keys else []
-    return run_viewer(scene, technique, backend=args.backend, frames=args.frames, screenshot=args.screenshot, keys=keys)
+    return run_viewer(
+        scene, technique, backend=args.backend, frames=args.frames, screenshot=args.screenshot, keys=keys,
+        gui=args.gui, settings=settings, size=size,
+    )
 
 
 def cmd_techniques(args) -> int:
@@ -113,6 +130,42 @@ def cmd_accuracy(args) -> int:
     return 0
 
 
+def cmd_bench(args) -> int:
+    from .bench import resolve_options, run
+
+    def names(text):
+        return [x.strip() for x in text.split(",") if x.strip()] if text else None
+
+    angles = None
+    if args.angles:
+        try:
+            angles = [float(x) for x in names(args.angles)]
+        except ValueError:
+            raise UserError(f"--angles {args.angles!r}: expected comma-separated degrees, e.g. 0,45,80") from None
+    resolution = None
+    if args.resolution:
+        try:
+            resolution = parse_size(args.resolution)
+        except UserError as e:
+            raise UserError(str(e).replace("--size", "--resolution")) from None
+    command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["bench"] else "wgpuviewer bench"
+    options = resolve_options(args.suite, resolution=resolution, heightmaps=names(args.heightmaps),
+                              techniques=names(args.techniques), angles=angles, frames=args.frames,
+                              backend=args.backend, command=command)
+    out = Path(args.out)
+    if args.from_csv:
+        from .bench import rereport
+
+        rereport([Path(p) for p in args.from_csv], out, command)
+        print(out / "report.md")
+        return 0
+    run(options, out, progress=not args.quiet)
+    for note in options.notes:
+        print(f"note: {note}", file=sys.stderr)
+    print(out / "report.md")
+    return 0
+
+
 def cmd_info(args) -> int:
     from .gpu import describe_adapters
 
@@ -134,6 +187,9 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("--frames", type=int, help="scripted run: draw this many frames, then exit")
     view.add_argument("--screenshot", help="scripted run: save the last frame to this PNG")
     view.add_argument("--keys", help="scripted run: comma-separated keys to press, one per frame (e.g. 2,3,ArrowRight)")
+    view.add_argument("--gui", choices=("glfw", "qt", "auto"), default="glfw",
+                      help="window toolkit through rendercanvas (default glfw; qt needs PySide6/PyQt6)")
+    view.add_argument("--size", help="window size WIDTHxHEIGHT in logical pixels (default: the saved size, 1280x720)")
     view.set_defaults(func=cmd_view)
 
     render = sub.add_parser("render", help="render a scene offscreen to PNG or .npy")
@@ -141,7 +197,7 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("-o", "--output", required=True, help="output file: .png (picture) or .npy (raw float32)")
     render.add_argument("--technique", help="technique (default: the scene's)")
     render.add_argument("--size", help=f"WIDTHxHEIGHT (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
-    render.add_argument("--mode", choices=("color", "uv", "depth", "cost"), default="color", help="what to write")
+    render.add_argument("--mode", choices=OUTPUT_MODES, default="color", help="what to write")
     render.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     render.set_defaults(func=cmd_render)
 
@@ -155,6 +211,21 @@ def build_parser() -> argparse.ArgumentParser:
     accuracy.add_argument("--height-scale", type=float, default=0.05, help="relief depth in UV units")
     accuracy.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     accuracy.set_defaults(func=cmd_accuracy)
+
+    bench = sub.add_parser("bench", help="speed against error of every technique (results.csv, report.md, plots)")
+    bench.add_argument("--out", required=True, help="output folder (results.csv, report.md, *.png)")
+    bench.add_argument("--suite", choices=("smoke", "full"), default="full",
+                       help="full: real GPUs (1920x1080, all maps and angles); smoke: minutes on a software adapter")
+    bench.add_argument("--resolution", help="frame WIDTHxHEIGHT (default: the suite's; full: 1920x1080)")
+    bench.add_argument("--heightmaps", help="comma-separated: builtins and/or scikit-image brick,grass,gravel")
+    bench.add_argument("--techniques", help="comma-separated technique names (default: all registered)")
+    bench.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 89)")
+    bench.add_argument("--frames", type=int, help="timed frames per configuration (median; default: the suite's)")
+    bench.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    bench.add_argument("--quiet", action="store_true", help="no progress bar")
+    bench.add_argument("--from-csv", nargs="+", metavar="CSV",
+                       help="measure nothing: write report.md and plots from these results.csv files into --out")
+    bench.set_defaults(func=cmd_bench)
 
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
     info.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
