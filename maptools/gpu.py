@@ -26,9 +26,14 @@ class GpuKernelError(UserError):
     """A kernel failed to compile, validate or run on this adapter."""
 
 
+# Snippets a kernel uses besides common.wgsl (prepended to every kernel).
+_INCLUDES = {"normal.wgsl": ("sobel.wgsl",), "complexity.wgsl": ("sobel.wgsl",)}
+
+
 def kernel_source(name: str) -> str:
     files = importlib.resources.files("wgpuviewer.wgsl.maps")
-    return (files / "common.wgsl").read_text() + "\n" + (files / name).read_text()
+    parts = ("common.wgsl", *_INCLUDES.get(name, ()), name)
+    return "\n".join((files / part).read_text() for part in parts)
 
 
 class MapGpu:

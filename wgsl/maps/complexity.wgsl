@@ -37,14 +37,9 @@ fn sobel_mag(@builtin(global_invocation_id) gid: vec3u) {
     var gx: f32;
     var gy: f32;
     if (P.ksize == 3u) {
-        // Same grouping as OpenCV's separable Sobel: centre*2 + (side + side).
-        let dm = h(x + 1, y - 1) - h(x - 1, y - 1);
-        let d0 = h(x + 1, y) - h(x - 1, y);
-        let dp = h(x + 1, y + 1) - h(x - 1, y + 1);
-        gx = d0 * 2.0 + (dm + dp);
-        let sm = h(x, y - 1) * 2.0 + (h(x - 1, y - 1) + h(x + 1, y - 1));
-        let sp = h(x, y + 1) * 2.0 + (h(x - 1, y + 1) + h(x + 1, y + 1));
-        gy = sp - sm;
+        let g = sobel3(x, y);
+        gx = g.x;
+        gy = g.y;
     } else {
         // 5x5: smoothing [1 4 6 4 1], derivative [-1 -2 0 2 1], separable (row pass, then column pass).
         var rx: array<f32, 5>;  // per row offset: derivative along x

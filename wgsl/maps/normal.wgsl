@@ -25,17 +25,8 @@ fn h(x: i32, y: i32) -> f32 {
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     if (gid.x >= P.width || gid.y >= P.height) { return; }
-    let x = i32(gid.x);
-    let y = i32(gid.y);
-    // Same grouping as OpenCV's separable Sobel: centre*2 + (side + side).
-    let dm = h(x + 1, y - 1) - h(x - 1, y - 1);
-    let d0 = h(x + 1, y) - h(x - 1, y);
-    let dp = h(x + 1, y + 1) - h(x - 1, y + 1);
-    let gx = d0 * 2.0 + (dm + dp);
-    let sm = h(x, y - 1) * 2.0 + (h(x - 1, y - 1) + h(x + 1, y - 1));
-    let sp = h(x, y + 1) * 2.0 + (h(x - 1, y + 1) + h(x + 1, y + 1));
-    let gy = sp - sm;
-    let n = normalize(vec3f(-P.strength * gx * 0.125, P.ysign * P.strength * gy * 0.125, 1.0));
+    let g = sobel3(i32(gid.x), i32(gid.y));
+    let n = normalize(vec3f(-P.strength * g.x * 0.125, P.ysign * P.strength * g.y * 0.125, 1.0));
     let i = (gid.y * P.width + gid.x) * 3u;
     dst[i] = n.x;
     dst[i + 1u] = n.y;
