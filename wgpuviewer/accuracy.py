@@ -63,7 +63,7 @@ DEFAULT_SETTINGS = (
     ("steep", {"layers": 32}), ("pom", {"layers": 8}), ("pom", {"layers": 32}), ("pom", {"layers": 256}),
     ("pom_adaptive", {}), ("pom_adaptive", {"angle_only": True}),
     ("relief", {}), ("relief", {"linear_steps": 32, "binary_steps": 8}),
-    ("maxmip", {}), ("distance", {}), ("distance_refined", {}),
+    ("maxmip", {}), ("distance", {}), ("distance_refined", {}), ("cone", {}),
 )
 
 

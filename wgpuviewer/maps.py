@@ -98,6 +98,18 @@ def _distance_refined(gpu: Gpu, depth: np.ndarray, height_scale: float, label: s
     return _volume_texture(gpu, volume, label)
 
 
+def _cone(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    # The ratios do not depend on height_scale (texels of u per unit t); cone.wgsl reads them with
+    # textureLoad (nearest texel), the lookup a filter="nearest" map is built for.
+    ratios = cached_generate("cone", 1.0 - depth, backend="auto", max_ratio=CONE_MAX_RATIO, filter=CONE_FILTER)
+    return create_texture(gpu, [np.asarray(ratios, np.float32)], "r32float", label)
+
+
+#: Relaxed cone map options: the widest stored cone (texels of u per unit t; the build costs O(max_ratio^2)
+#: per texel) and the lookup cone.wgsl uses.
+CONE_MAX_RATIO = 32.0
+CONE_FILTER = "nearest"
+
 #: Depth slices of the distance volumes (maptools' default).
 DISTANCE_SLICES = 16
 
@@ -113,6 +125,7 @@ MAP_SLOTS: dict[str, MapSlot] = {
         # Both distance maps bind at the same slot: distance.wgsl reads whichever the technique needs.
         MapSlot("distance", 7, _VOLUME, _distance),
         MapSlot("distance_refined", 7, _VOLUME, _distance_refined),
+        MapSlot("cone", 8, {"texture": {"sample_type": "unfilterable-float", "view_dimension": "2d"}}, _cone),
     )
 }
 

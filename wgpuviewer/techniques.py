@@ -22,6 +22,7 @@ TRACE_FIELDS = (
     "linear_steps", "binary_steps",  # relief
     "max_steps",  # maxmip
     "iterations", "cone_cos",  # distance, distance_refined (cone_cos: fixed by the map, see Technique.fixed)
+    "gap_stop",  # cone (also iterations, binary_steps)
 )
 
 #: Hard cap on any layer count, mirrored by ``MAX_LAYERS`` in the WGSL prelude.
@@ -179,6 +180,22 @@ TECHNIQUES: dict[str, Technique] = {
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
             ray_search=True, wgsl="distance.wgsl",
             fixed=(("cone_cos", math.cos(math.radians(REFINED_MAX_ANGLE))),),
+        ),
+        Technique(
+            "cone", "-",
+            "Relaxed cone stepping (Policarpo & Oliveira) on maptools' conservative cone map: steps of "
+            "(D - t) c / (k + c) that never pass the first hit, then binary search of the bracket (the free end "
+            "is returned). Rays usually converge onto the surface and stop within gap_stop of it.",
+            "per cone step 1 depth + 1 cone-map fetch, then binary_steps depth fetches: "
+            "at most 2*iterations + binary_steps",
+            ("albedo", "normal", "depth", "cone"),
+            (
+                Param("iterations", 128, 1, 4096, int, "cap on cone steps (capped rays are flagged, stop short)"),
+                Param("binary_steps", 6, 0, 32, int, "halvings of the bracket once a step ends below the surface"),
+                Param("gap_stop", 1e-4, 0.0, 0.1, float, "stop when the ray is this close above the surface "
+                      "(layer depth t)"),
+            ),
+            ray_search=True,
         ),
     )
 }

@@ -29,6 +29,8 @@ struct TraceResult {
 @group(1) @binding(6) var maxmip_tex: texture_2d<f32>;
 // Distance volume (distance.wgsl): r32float (W, H, slices), plain or visibility-refined, textureLoad.
 @group(1) @binding(7) var distance_tex: texture_3d<f32>;
+// Relaxed cone map (cone.wgsl): r32float (W, H) cone ratios, texels of u per unit t, textureLoad.
+@group(1) @binding(8) var cone_tex: texture_2d<f32>;
 
 // Counted so every technique reports its cost the same way.
 var<private> fetch_count: u32;
