@@ -254,3 +254,13 @@ def test_layers_mode_shows_the_adaptive_layer_count(scene_renderer):
     assert np.array_equal(grey[image.covered][:, 0], expected.astype(np.uint8))
     fixed = mode_data(scene_renderer.render("relief", (64, 36)), "layers")
     assert set(np.unique(fixed[np.isfinite(fixed)])) == {16.0}
+
+
+def test_cost_scale_bounds_each_search():
+    """The cost view's full heat: the fetch bound of layer searches, a common scale otherwise."""
+    from wgpuviewer.techniques import COMMON_COST_SCALE, TECHNIQUES
+
+    assert TECHNIQUES["pom"].cost_scale({"layers": 32}) == 33
+    assert TECHNIQUES["pom_adaptive"].cost_scale(TECHNIQUES["pom_adaptive"].defaults()) == 33
+    assert TECHNIQUES["relief"].cost_scale({"linear_steps": 16, "binary_steps": 6}) == 23
+    assert TECHNIQUES["maxmip"].cost_scale(TECHNIQUES["maxmip"].defaults()) == COMMON_COST_SCALE

@@ -254,8 +254,7 @@ class Renderer:
         """
         technique = get_technique(technique_name)
         params = self.params.get(technique.name) or technique.defaults()
-        cost_scale = float(params.get("layers", 1)) + 2.0
-        self._write_frame(camera, size, mode, cost_scale)
+        self._write_frame(camera, size, mode, technique.cost_scale(params))
         pipeline = self.pipeline(technique, formats)
         groups = {}
         for material_name in {m for m, *_ in self._objects}:

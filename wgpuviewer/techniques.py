@@ -25,6 +25,9 @@ TRACE_FIELDS = (
     "gap_stop",  # cone (also iterations, binary_steps)
 )
 
+#: Full heat of the cost view for techniques without a layer bound (fetches per pixel).
+COMMON_COST_SCALE = 64.0
+
 #: Hard cap on any layer count, mirrored by ``MAX_LAYERS`` in the WGSL prelude.
 MAX_LAYERS = 1024
 
@@ -82,6 +85,17 @@ class Technique:
 
     def defaults(self) -> dict:
         return {p.name: p.kind(p.default) for p in self.params}
+
+    def cost_scale(self, params: dict) -> float:
+        """Fetch count drawn as full heat in the cost view: the search's own bound where its parameters
+        give one (layer and linear searches), else a common scale so techniques compare side by side."""
+        if "layers" in params:
+            return float(params["layers"] + 1)
+        if "max_layers" in params:
+            return float(params["max_layers"] + 1)
+        if "linear_steps" in params:
+            return float(params["linear_steps"] + 1 + params.get("binary_steps", 0))
+        return COMMON_COST_SCALE
 
     def trace_values(self, params: dict) -> dict:
         """What goes into the TraceParams uniform: the parameters plus the technique's fixed values."""

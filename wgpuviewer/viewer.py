@@ -30,6 +30,7 @@ from .renderer import DEPTH_FORMAT, Renderer
 from .scene import Camera, Scene
 from .settings import LIMITS, Settings, save_settings
 from .stats import FrameStats, GpuTimer
+from .techniques import get_technique
 
 MOVE_SPEED = 1.5  # scene units per second (default; settings.move_speed)
 LOOK_SPEED = 0.005  # radians per pixel dragged (default; settings.look_sensitivity)
@@ -337,8 +338,8 @@ class Viewer:
         self.stats.reset()
 
     def cost_scale(self) -> float:
-        params = self.renderer.params.get(self.technique) or {}
-        return float(params.get("layers", 1)) + 2.0
+        technique = get_technique(self.technique)
+        return technique.cost_scale(self.renderer.params.get(self.technique) or technique.defaults())
 
     def material_height_scales(self) -> str:
         return ", ".join(f"{m.height_scale:g}" for m in self.scene.materials.values())
