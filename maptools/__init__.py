@@ -18,7 +18,7 @@ from .io import load_height_input, validate_height
 __all__ = ["generate", "load_height_input", "validate_height", "resolve_backend", "VERSION", "KINDS"]
 
 #: Version of the map algorithms; part of every cache key (bump when an output changes).
-VERSION = "maptools-1"
+VERSION = "maptools-2"
 
 _notice_printed = False
 

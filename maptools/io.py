@@ -160,8 +160,11 @@ def atomic_open(path):
     error it is removed. A process killed mid-write can leave only that hidden temp file, never a partial
     ``path``; ``remove_stale_temps`` clears such leftovers."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as error:
+        raise UserError(f"{path}: cannot write here ({error.strerror or error}); choose another folder") from None
     try:
         with os.fdopen(fd, "wb") as f:
             yield f

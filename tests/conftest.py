@@ -9,6 +9,7 @@ import os
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -17,6 +18,25 @@ IN_CI = bool(os.environ.get("CI"))
 
 def pytest_addoption(parser):
     parser.addoption("--regen-golden", action="store_true", help="rewrite tests/golden/ from this adapter's renders")
+
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="session", autouse=True)
+def isolated_user_dirs(tmp_path_factory):
+    """Tests never touch the user's settings or map cache. Generated maps go to a cache of the test
+    suite's own, kept between runs (building 3D maps is slow on a software adapter); subprocesses
+    inherit both variables."""
+    saved = {name: os.environ.get(name) for name in ("WGPUVIEWER_CACHE_DIR", "WGPUVIEWER_CONFIG_DIR")}
+    os.environ["WGPUVIEWER_CACHE_DIR"] = str(ROOT / ".pytest_cache" / "map-cache")
+    os.environ["WGPUVIEWER_CONFIG_DIR"] = str(tmp_path_factory.mktemp("config"))
+    yield
+    for name, value in saved.items():
+        if value is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = value
 
 
 @functools.cache

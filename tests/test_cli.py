@@ -60,6 +60,10 @@ def test_render_is_byte_identical_across_runs(tmp_path, adapter):
         (["render", "-o", "x.jpg"], ["x.jpg", ".png", ".npy"]),
         (["render", "missing.toml", "-o", "x.png"], ["missing.toml"]),
         (["view", "missing.toml"], ["missing.toml"]),
+        (["missing.toml"], ["missing.toml"]),  # no command: view
+        (["render", "-o", "/proc/no/such/a.png", "--size", "8x8"], ["/proc/no/such/a.png", "cannot write"]),
+        (["accuracy", "--rays", "0"], ["--rays"]),
+        (["bench", "--out", "o", "--heightmaps", ","], ["--heightmaps"]),
     ],
 )
 def test_user_errors_exit_2_with_one_line(tmp_path, args, fragments):

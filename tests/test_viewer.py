@@ -177,3 +177,15 @@ def test_missing_qt_is_a_clear_error(monkeypatch, tmp_path, capsys):
     assert main(["view", "--gui", "qt", "--frames", "2"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("wgpuviewer: error: --gui qt:") and "pip install PySide6" in err
+
+
+def test_scripted_run_errors_end_the_run(display, tmp_path, adapter):
+    """A failure inside a frame (here: an unwritable screenshot path) ends a scripted run with one line
+    and exit 2 instead of redrawing forever; unknown keys are refused up front."""
+    env = {**os.environ, "DISPLAY": display, "WGPUVIEWER_CONFIG_DIR": str(tmp_path)}
+    base = [sys.executable, "-m", "wgpuviewer", "view", "--size", "160x100", "--frames", "2"]
+    result = subprocess.run([*base, "--screenshot", "/proc/no/such/shot.png"], capture_output=True, text=True,
+                            timeout=120, env=env)
+    assert result.returncode == 2 and "cannot write" in result.stderr and "Traceback" not in result.stderr
+    result = subprocess.run([*base, "--keys", "Nope"], capture_output=True, text=True, timeout=120, env=env)
+    assert result.returncode == 2 and "--keys: unknown key 'Nope'" in result.stderr

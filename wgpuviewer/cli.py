@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from pathlib import Path
@@ -109,6 +110,12 @@ def cmd_techniques(args) -> int:
 
 
 def cmd_accuracy(args) -> int:
+    if args.rays < 1:
+        raise UserError(f"--rays {args.rays}: expected at least 1 ray")
+    if not (math.isfinite(args.height_scale) and 0 < args.height_scale <= 1):
+        raise UserError(f"--height-scale {args.height_scale}: expected a relief depth in (0, 1] UV units")
+    if args.texels < 1:
+        raise UserError(f"--texels {args.texels}: expected at least 1 texel")
     from tqdm import tqdm
 
     from .accuracy import DEFAULT_ANGLES, DEFAULT_SETTINGS, table
@@ -133,13 +140,18 @@ def cmd_accuracy(args) -> int:
 def cmd_bench(args) -> int:
     from .bench import resolve_options, run
 
-    def names(text):
-        return [x.strip() for x in text.split(",") if x.strip()] if text else None
+    def names(text, option):
+        if text is None:
+            return None
+        items = [x.strip() for x in text.split(",") if x.strip()]
+        if not items:
+            raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
+        return items
 
     angles = None
     if args.angles:
         try:
-            angles = [float(x) for x in names(args.angles)]
+            angles = [float(x) for x in names(args.angles, "--angles")]
         except ValueError:
             raise UserError(f"--angles {args.angles!r}: expected comma-separated degrees, e.g. 0,45,80") from None
     resolution = None
@@ -149,8 +161,8 @@ def cmd_bench(args) -> int:
         except UserError as e:
             raise UserError(str(e).replace("--size", "--resolution")) from None
     command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["bench"] else "wgpuviewer bench"
-    options = resolve_options(args.suite, resolution=resolution, heightmaps=names(args.heightmaps),
-                              techniques=names(args.techniques), angles=angles, frames=args.frames,
+    options = resolve_options(args.suite, resolution=resolution, heightmaps=names(args.heightmaps, "--heightmaps"),
+                              techniques=names(args.techniques, "--techniques"), angles=angles, frames=args.frames,
                               backend=args.backend, command=command)
     out = Path(args.out)
     if args.from_csv:
@@ -233,11 +245,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+COMMANDS = ("view", "render", "techniques", "accuracy", "bench", "info")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or (argv[0] not in COMMANDS and argv[0] not in ("-h", "--help")):
+        argv = ["view", *argv]  # `wgpuviewer [SCENE] [--technique ...]` means view
     args = parser.parse_args(argv)
-    if args.command is None:
-        args = parser.parse_args(["view", *(argv or [])])
     try:
         return args.func(args)
     except UserError as error:

@@ -63,13 +63,17 @@ def texel_size(renderer: Renderer) -> tuple[int, int]:
     return max(sizes, key=lambda s: s[0] * s[1])
 
 
-def reference_render(renderer: Renderer, size, camera):
-    """Offscreen render of the reference technique (its parameters swapped in for the call)."""
+def reference_render(renderer: Renderer, size, camera, height_scale: float | None = None):
+    """Offscreen render of the reference technique (its parameters swapped in for the call).
+
+    ``height_scale``: the compared technique's live override, so both trace the same relief (None: the
+    materials' own scales)."""
     saved = renderer.params.get(REFERENCE)
-    renderer.params[REFERENCE] = {**(saved or {}), "layers": REFERENCE_LAYERS}
-    renderer.params[REFERENCE].pop("height_scale", None)
-    if saved and "height_scale" in saved:  # a live height-scale override applies to the reference too
-        renderer.params[REFERENCE]["height_scale"] = saved["height_scale"]
+    params = {key: value for key, value in (saved or {}).items() if key != "height_scale"}
+    params["layers"] = REFERENCE_LAYERS
+    if height_scale is not None:
+        params["height_scale"] = height_scale
+    renderer.params[REFERENCE] = params
     try:
         return renderer.render(REFERENCE, size, camera)
     finally:
@@ -80,8 +84,10 @@ def reference_render(renderer: Renderer, size, camera):
 
 
 def error_map(renderer: Renderer, technique: str, size, camera, reference=None) -> np.ndarray:
-    """(H, W) float32 UV error in texels; -1 where nothing was drawn. ``reference``: a render to reuse."""
-    ref = reference if reference is not None else reference_render(renderer, size, camera)
+    """(H, W) float32 UV error in texels; -1 where nothing was drawn. ``reference``: a render to reuse
+    (made with ``reference_render`` at this technique's height scale)."""
+    override = (renderer.params.get(technique) or {}).get("height_scale")
+    ref = reference if reference is not None else reference_render(renderer, size, camera, override)
     img = renderer.render(technique, size, camera)
     covered = img.covered & ref.covered
     err = np.full(covered.shape, -1.0, np.float32)

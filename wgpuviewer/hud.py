@@ -15,6 +15,7 @@ except ImportError:  # the viewer then runs without a HUD (window title only)
     imgui = None
     ImguiRenderer = None
 
+from .maps import height_scale_adjustable
 from .techniques import get_technique
 
 AVAILABLE = imgui is not None
@@ -117,7 +118,7 @@ class Hud:
                 values[p.name] = p.kind(new)
             if imgui.is_item_hovered():
                 imgui.set_tooltip(p.doc)
-        if technique.needs_depth:
+        if technique.needs_depth and height_scale_adjustable(technique.textures):
             override = "height_scale" in values
             changed, on = imgui.checkbox(f"override height scale##{tag}", override)
             if changed:
@@ -144,7 +145,7 @@ class Hud:
             t = get_technique(name)
             prefix = f"{tag}: " if v.split else ""
             active = v.split and tag == v.active_side
-            imgui.text_colored(YELLOW if active else WHITE, f"{prefix}{t.key}  {t.name}")
+            imgui.text_colored(YELLOW if active else WHITE, f"{prefix}{v.key_for(t.name)}  {t.name}")
             imgui.push_text_wrap_pos(0.0)
             imgui.text_colored(GREY, t.description)
             imgui.pop_text_wrap_pos()

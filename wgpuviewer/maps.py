@@ -26,6 +26,8 @@ class MapSlot:
     binding: int  # @group(1) @binding(N) in prelude.wgsl
     layout: dict  # bind-group layout entry without binding/visibility
     build: Callable[[Gpu, np.ndarray, float, str], wgpu.GPUTexture]  # (gpu, depth, height_scale, label)
+    #: Built for the material's height_scale: a tracer given another scale could step through the surface.
+    scale_bound: bool = False
 
 
 def _depth(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
@@ -123,8 +125,8 @@ MAP_SLOTS: dict[str, MapSlot] = {
         MapSlot("complexity", 5, _FILTERABLE_2D, _complexity),
         MapSlot("maxmip", 6, {"texture": {"sample_type": "unfilterable-float", "view_dimension": "2d"}}, _maxmip),
         # Both distance maps bind at the same slot: distance.wgsl reads whichever the technique needs.
-        MapSlot("distance", 7, _VOLUME, _distance),
-        MapSlot("distance_refined", 7, _VOLUME, _distance_refined),
+        MapSlot("distance", 7, _VOLUME, _distance, scale_bound=True),
+        MapSlot("distance_refined", 7, _VOLUME, _distance_refined, scale_bound=True),
         MapSlot("cone", 8, {"texture": {"sample_type": "unfilterable-float", "view_dimension": "2d"}}, _cone),
     )
 }
@@ -136,3 +138,8 @@ def layout_entries(names, visibility) -> list[dict]:
         {"binding": MAP_SLOTS[n].binding, "visibility": visibility, **MAP_SLOTS[n].layout}
         for n in names if n in MAP_SLOTS
     ]
+
+
+def height_scale_adjustable(textures) -> bool:
+    """Whether a technique sampling ``textures`` may trace at another height scale than its maps were built for."""
+    return not any(MAP_SLOTS[t].scale_bound for t in textures if t in MAP_SLOTS)

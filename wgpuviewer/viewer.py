@@ -355,6 +355,18 @@ class Viewer:
 
     # --- input -------------------------------------------------------------------------------
 
+    #: Keys ``press`` acts on (scripted runs may use these; the fly keys WASD/QE act while held).
+    KEYS = frozenset(
+        [str(d) for d in range(10)]
+        + ["ArrowRight", "ArrowLeft", "r", "R", "D", "E", "m", "M", "b", "B", "Tab", "o", "O", "h", "H",
+           "x", "X", "c", "C", "F1", "p", "P", "v", "V", "F11", "F5", "Escape"]
+    )
+
+    def key_for(self, technique: str) -> str:
+        """The number key that selects ``technique`` in this scene (its position: 1..9, then 0)."""
+        index = self.techniques.index(technique)
+        return str((index + 1) % 10) if index < 10 else "←/→"
+
     def press(self, key: str):
         """What a key does (also used by scripted runs)."""
         lower = key.lower()
@@ -469,10 +481,20 @@ class Viewer:
             return
         if self._error is None:
             self._error = error_view.ErrorOverlay(self.gpu.device, self.format)
-        reference = error_view.reference_render(self.renderer, size, camera)
-        values = error_view.error_map(self.renderer, techniques[0], size, camera, reference)
+        # One reference per height-scale override in use (each technique is compared on its own relief).
+        references = {}
+        for t in techniques:
+            override = (self.renderer.params.get(t) or {}).get("height_scale")
+            if override not in references:
+                references[override] = error_view.reference_render(self.renderer, size, camera, override)
+
+        def error_of(t):
+            override = (self.renderer.params.get(t) or {}).get("height_scale")
+            return error_view.error_map(self.renderer, t, size, camera, references[override])
+
+        values = error_of(techniques[0])
         if self.split:
-            right = error_view.error_map(self.renderer, techniques[1], size, camera, reference)
+            right = error_of(techniques[1])
             xs = int(round(self.split_x * size[0]))
             values[:, xs:] = right[:, xs:]
         self.error_texels = error_view.texel_size(self.renderer)
@@ -577,14 +599,21 @@ class Viewer:
             logging.getLogger(name).addHandler(errors)
 
         def frame():
-            if pending:
-                self.press(pending.pop(0))
-            texture = self.draw()
-            state["frame"] += 1
-            if frames is not None and state["frame"] >= frames:
-                if screenshot:
-                    save_rgb_png(Path(screenshot), self.read_frame(texture))
-                    print(screenshot)
+            try:
+                if pending:
+                    self.press(pending.pop(0))
+                texture = self.draw()
+                state["frame"] += 1
+                if frames is not None and state["frame"] >= frames:
+                    if screenshot:
+                        save_rgb_png(Path(screenshot), self.read_frame(texture))
+                        print(screenshot)
+                    self.canvas.close()
+            except BaseException as error:
+                # rendercanvas would log it and call us again forever: stop, and report it after the loop.
+                if frames is None and not isinstance(error, UserError):
+                    raise
+                state["error"] = error
                 self.canvas.close()
 
         self.canvas.request_draw(frame)
@@ -593,6 +622,8 @@ class Viewer:
         finally:
             for name in ("wgpu", "rendercanvas"):
                 logging.getLogger(name).removeHandler(errors)
+        if "error" in state:
+            raise state["error"]
         if frames is not None and errors.count:
             print(f"wgpuviewer: error: {errors.count} error(s) logged while drawing", file=sys.stderr)
             return 1
@@ -619,6 +650,9 @@ def run_viewer(
         frames = max(len(keys), 0) + 3  # a screenshot implies a scripted run
     if screenshot and not screenshot.lower().endswith(".png"):
         raise UserError(f"--screenshot {screenshot}: expected a .png path")
+    unknown = [k for k in keys if k not in Viewer.KEYS]
+    if unknown:
+        raise UserError(f"--keys: unknown key {unknown[0]!r}; known: {', '.join(sorted(Viewer.KEYS))}")
     scripted = frames is not None
     viewer = Viewer(scene, technique, backend, gui=gui, settings=settings, size=size, scripted=scripted)
     if not scripted:
