@@ -30,7 +30,7 @@ def adapter_family(summary: str) -> str:
 
 @pytest.fixture(scope="module")
 def default_renderer(gpu):
-    return Renderer(load_scene(default_scene_path()), gpu)
+    return Renderer(load_scene(GOLDEN / "scene.toml"), gpu)
 
 
 @pytest.mark.parametrize("technique", list(TECHNIQUES))
