@@ -196,7 +196,6 @@ def refine(dsolid: np.ndarray, dfree: np.ndarray, w: int, h: int, slices: int, h
     best = np.full(euclid.shape, np.inf)
     active = np.flatnonzero(euclid > eps)  # elsewhere every l_s = 0: the stored value is 0 either way
     x0, y0, z0 = xc.ravel()[active], yc.ravel()[active], zc.ravel()[active]
-    ztop = slices * sp[2]
     bstep_min = 0.5 * min(sp)
     for s in dirs:
         b = best[active]

@@ -28,7 +28,6 @@ DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, d
 LAYERS_FORMAT = "r32uint"  # offscreen: depth layers the search used per pixel
 DEPTH_FORMAT = "depth32float"
 FRAME_SIZE = 64 + 16 + 16 + MAX_LIGHTS * 32
-OBJECT_SIZE = 64 + 64 + 16
 
 #: Frame.mode values (render.wgsl).
 MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4}

@@ -32,9 +32,7 @@ from .settings import LIMITS, Settings, save_settings
 from .stats import FrameStats, GpuTimer
 from .techniques import get_technique
 
-MOVE_SPEED = 1.5  # scene units per second (default; settings.move_speed)
 LOOK_SPEED = 0.005  # radians per pixel dragged (default; settings.look_sensitivity)
-GUIS = ("glfw", "qt", "auto")
 MODES = ("color", "cost", "error")
 
 #: (keys, what they do): the help panel and the README.
