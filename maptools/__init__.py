@@ -1,6 +1,6 @@
 """Map generation for relief mapping: normal, complexity, maximum-pyramid and 3D distance maps from height maps.
 
-Each kind has a WGSL compute kernel (``wgpuviewer.wgsl.maps``), a CPU implementation (OpenCV/numpy) that is
+Each kind has a WGSL compute kernel (``wgsl/maps/``), a CPU implementation (OpenCV/numpy) that is
 both the fallback and the cross-check, and an entry in :data:`maptools.registry.KINDS`.
 
 Conventions: heights are float32 (H, W) in [0, 1], 1 = top; columns are u (x, right), rows are v with
@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import sys
 
-from wgpuviewer.errors import NoAdapterError, UserError
+from wgpuviewer.core.errors import NoAdapterError, UserError
 
-from .io import load_height_input, validate_height
+from .io import validate_height
 
-__all__ = ["generate", "load_height_input", "validate_height", "resolve_backend", "VERSION", "KINDS"]
+__all__ = ["generate", "validate_height", "resolve_backend", "VERSION", "KINDS"]
 
 #: Version of the map algorithms; part of every cache key (bump when an output changes).
 VERSION = "maptools-2"

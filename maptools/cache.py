@@ -15,8 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
+from wgpuviewer.core.io import atomic_open
+
 from . import VERSION, generate, validate_height
-from .io import atomic_open, read_maxmip, write_maxmip
+from .io import read_maxmip, write_maxmip
 from .registry import get_kind
 
 CACHE_ENV = "WGPUVIEWER_CACHE_DIR"

@@ -6,6 +6,7 @@ Exit codes: 0 success, 1 a batch job or a check failed, 2 a user error (one line
 from __future__ import annotations
 
 import argparse
+import functools
 import hashlib
 import json
 import sys
@@ -14,10 +15,12 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from wgpuviewer.errors import UserError
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.images import HEIGHT_CHANNELS, NAN_POLICIES, read_height
+from wgpuviewer.core.io import atomic_open, remove_stale_temps
 
-from . import VERSION, generate, load_height_input, resolve_backend
-from .io import CHANNELS, INPUT_EXTS, NAN_POLICIES, atomic_open, remove_stale_temps, write_result
+from . import VERSION, generate, resolve_backend
+from .io import INPUT_EXTS, write_result
 from .registry import KINDS, get_kind
 
 
@@ -26,8 +29,8 @@ def _flag(name: str) -> str:
 
 
 def _add_input_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--channel", default="auto", choices=CHANNELS,
-                   help="channel of a colour input (auto: grey, or a colour image with equal channels)")
+    p.add_argument("--channel", default="auto", choices=HEIGHT_CHANNELS,
+                   help="channel of a colour input (auto: a grey file as it is, a colour one as its Rec. 709 luma)")
     p.add_argument("--nan-policy", default="error", choices=NAN_POLICIES,
                    help="NaN/inf texels: error (refuse), zero, nearest (nearest finite texel)")
 
@@ -117,7 +120,7 @@ def cmd_generate(args) -> int:
     out = Path(args.output)
     if out.suffix.lower() not in kind.extensions:
         raise UserError(f"{out}: {kind.name} maps are written as {', '.join(kind.extensions)}")
-    height = load_height_input(args.input, args.channel, args.nan_policy)
+    height = read_height(args.input, args.channel, args.nan_policy)
     result = generate(kind.name, height, backend=args.backend, **opts)
     write_result(kind, result, out, args.bits)
     print(f"wrote {out}")
@@ -228,7 +231,7 @@ def cmd_batch(args) -> int:
                     continue
                 remove_stale_temps(out)  # left by a killed earlier run: this job owns `out`
                 if height is None:
-                    height = load_height_input(f, args.channel, args.nan_policy)
+                    height = read_height(f, args.channel, args.nan_policy)
                 result = generate(k, height, backend=backend, **kopts[k])
                 write_result(kind, result, out, args.bits)
                 with atomic_open(sidecar(out)) as fh:
@@ -285,7 +288,7 @@ def cmd_check(args) -> int:
 
     kinds = _parse_kinds(args.kinds)
     sets = _parse_sets(args.set)
-    height = load_height_input(args.input, args.channel, args.nan_policy)
+    height = read_height(args.input, args.channel, args.nan_policy)
     g = gpu.runner()  # NoAdapterError (exit 2) when there is no GPU to check
     print(f"{args.input}: {height.shape[1]}x{height.shape[0]} on {g.gpu.summary}")
     bad = 0
@@ -344,8 +347,8 @@ def cmd_bench(args) -> int:
         for n in _sizes(getattr(args, attr), _flag(attr)):
             height = rng.random((n, n)).astype(np.float32)
             kind.gpu(height, **opts)  # warm-up: pipeline compilation
-            tg = _best_time(lambda: kind.gpu(height, **opts), args.repeat)
-            tc = _best_time(lambda: kind.cpu(height, **opts), args.repeat)
+            tg = _best_time(functools.partial(kind.gpu, height, **opts), args.repeat)
+            tc = _best_time(functools.partial(kind.cpu, height, **opts), args.repeat)
             size = f"{n}x{n}" + (f"x{opts['slices']}" if "slices" in opts else "")
             print(f"{k:<17} {size:>11} {tc:9.4f} {tg:9.4f} {tc / tg:8.2f}")
     return 0

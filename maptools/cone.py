@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from wgpuviewer.errors import UserError
+from wgpuviewer.core.errors import UserError
 
 #: Relative margin every stored ratio loses (covers float32 arithmetic on the GPU and the float32 store).
 STORE_MARGIN = 2.0 ** -12

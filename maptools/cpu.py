@@ -61,10 +61,7 @@ def complexity(height: np.ndarray, *, ksize: int = 3, dilate_kernel: int = 3, it
     gx, gy = sobel(height, ksize, border)
     mag = np.sqrt(gx ** 2 + gy ** 2)
     mx = np.max(mag)
-    if not mx > 0:
-        c = np.zeros_like(mag)
-    else:
-        c = np.clip(mag / mx, 0, 1)
+    c = np.zeros_like(mag) if not mx > 0 else np.clip(mag / mx, 0, 1)
     kernel = np.ones((dilate_kernel, dilate_kernel), np.uint8)
     if border == "repeat":
         r = dilation_radius(dilate_kernel, iterations)

@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from wgpuviewer.errors import UserError
+from wgpuviewer.core.errors import UserError
 
 #: Largest volume (W * H * slices) the 3D kinds generate: 2^23 voxels = 32 MiB of float32 (e.g. 512x512x32).
 MAX_VOXELS = 1 << 23
@@ -212,7 +212,7 @@ def refine(dsolid: np.ndarray, dfree: np.ndarray, w: int, h: int, slices: int, h
             run[idx[stop]] = False
             go = idx[~stop]
             L[go] += g[~stop] / (1.0 + alpha)
-        cand = np.flatnonzero(L < b)
+        cand = np.flatnonzero(b > L)
         if not cand.size:
             continue
         # backward: is (c, s) certainly occluded?

@@ -1,4 +1,4 @@
-"""GPU paths of the map kinds: drive the WGSL compute kernels in ``wgpuviewer.wgsl.maps``.
+"""GPU paths of the map kinds: drive the WGSL compute kernels in ``wgsl/maps/``.
 
 Maps travel as row-major f32 storage buffers (exact texel values, no sampler or format conversion);
 results are read back with ``device.queue.read_buffer``. One lock serialises GPU work so that the
@@ -7,14 +7,14 @@ batch tool's worker threads can share the single device.
 
 from __future__ import annotations
 
-import importlib.resources
 import threading
 
 import numpy as np
 import wgpu
 
-from wgpuviewer.errors import UserError
-from wgpuviewer.gpu import get_gpu
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.gpu import get_gpu
+from wgpuviewer.core.wgsl import compose
 
 from . import cpu
 
@@ -26,14 +26,6 @@ class GpuKernelError(UserError):
     """A kernel failed to compile, validate or run on this adapter."""
 
 
-# Snippets a kernel uses besides common.wgsl (prepended to every kernel).
-_INCLUDES = {"normal.wgsl": ("sobel.wgsl",), "complexity.wgsl": ("sobel.wgsl",)}
-
-
-def kernel_source(name: str) -> str:
-    files = importlib.resources.files("wgpuviewer.wgsl.maps")
-    parts = ("common.wgsl", *_INCLUDES.get(name, ()), name)
-    return "\n".join((files / part).read_text() for part in parts)
 
 
 class MapGpu:
@@ -48,16 +40,17 @@ class MapGpu:
     def pipeline(self, file: str, entry: str) -> wgpu.GPUComputePipeline:
         key = (file, entry)
         if key not in self._pipelines:
+            source = compose(f"maps/{file}")  # the kernel with what it includes (wgsl/common/)
             try:
                 if file not in self._modules:
                     self._modules[file] = self.device.create_shader_module(
-                        label=f"maptools {file}", code=kernel_source(file))
+                        label=f"maptools {file}", code=source.code)
                 self._pipelines[key] = self.device.create_compute_pipeline(
                     label=f"maptools {file}:{entry}", layout="auto",
                     compute={"module": self._modules[file], "entry_point": entry})
             except (wgpu.GPUValidationError, wgpu.GPUPipelineError) as exc:
                 raise GpuKernelError(f"GPU kernel {file}:{entry} failed to build on {self.gpu.summary}: "
-                                     f"{_first_line(exc)}; use --backend cpu") from None
+                                     f"{source.locate(str(exc))}; use --backend cpu") from None
         return self._pipelines[key]
 
     # -- resources ---------------------------------------------------------------------------------

@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from wgpuviewer.errors import UserError
+from wgpuviewer.core.errors import UserError
 
-from . import cpu, gpu, io
 from . import cone as cn
+from . import cpu, gpu, io
 from . import distance as dist
 
 

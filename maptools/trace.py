@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from wgpuviewer.core.sampling import bilinear
+
 
 def sphere_trace(vol: np.ndarray, uv0, view_dir, height_scale: float, *, stop: float = 1e-3,
                  max_steps: int = 256) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -77,7 +79,7 @@ def cone_trace(cmap: np.ndarray, depth: np.ndarray, uv0, view_dir, height_scale:
     """Relaxed cone stepping (docs/maps.md, "Relaxed cone map"), float64, vectorised over rays.
 
     ``cmap`` (H, W): cone ratios (texels of u per unit t); ``depth`` (H, W): D = 1 - H, sampled bilinear with
-    repeat addressing (``wgpuviewer.reference.sample_bilinear``). Per ray, from t = 0 at uv0, with
+    repeat addressing (``wgpuviewer.core.sampling.bilinear``). Per ray, from t = 0 at uv0, with
     k = |V.xy / V.z| * S * W (texels travelled per unit t):
 
         loop (<= max_steps):  D = depth(p) (bilinear);  if t >= D: bracket [t_prev, t]; break
@@ -91,7 +93,6 @@ def cone_trace(cmap: np.ndarray, depth: np.ndarray, uv0, view_dir, height_scale:
     bracket: lo = last free point, hi = first solid point; hi = NaN without a bracket), steps (cone steps = depth
     fetches of the cone phase), status (BRACKETED, GAP_STOP, CAPPED).
     """
-    from wgpuviewer.reference import sample_bilinear
 
     rows, cols = depth.shape
     uv0 = np.atleast_2d(np.asarray(uv0, np.float64))
@@ -112,7 +113,7 @@ def cone_trace(cmap: np.ndarray, depth: np.ndarray, uv0, view_dir, height_scale:
 
     def depth_at(idx, tt):
         p = p0[idx] + tt[:, None] * dxy[idx]
-        return sample_bilinear(depth, p / cols), p
+        return bilinear(depth, p / cols), p
 
     for _ in range(max_steps):
         if not run.size:
@@ -126,10 +127,7 @@ def cone_trace(cmap: np.ndarray, depth: np.ndarray, uv0, view_dir, height_scale:
         status[run[gap]] = GAP_STOP
         go = ~(solid | gap)
         idx, d, p = run[go], d[go], p[go]
-        if lookup == "nearest":
-            c = _lookup_nearest(cmap, p[:, 0], p[:, 1])
-        else:
-            c = _lookup_bilinear(cmap, p[:, 0], p[:, 1])
+        c = _lookup_nearest(cmap, p[:, 0], p[:, 1]) if lookup == "nearest" else _lookup_bilinear(cmap, p[:, 0], p[:, 1])
         kk = k[idx]
         frac = np.where(kk > 0, c / np.where(kk + c > 0, kk + c, 1.0), 1.0)
         lo[idx] = t[idx]

@@ -1,5 +1,7 @@
-"""Shared fixtures: one adapter check per session (in a subprocess, with a timeout), failing on
-ERROR logs from wgpu/rendercanvas, a virtual display for window tests, golden-image options."""
+"""The one conftest: one adapter check per session (in a subprocess, with a timeout) behind the ``adapter`` and
+``gpu`` fixtures and the ``requires_gpu`` marker, failing on ERROR logs from wgpu/rendercanvas, a virtual display
+for window tests, golden-image options. Test folders mirror the packages (core, relief, viewer, bench, maptools,
+studies)."""
 
 from __future__ import annotations
 
@@ -17,7 +19,17 @@ IN_CI = bool(os.environ.get("CI"))
 
 
 def pytest_addoption(parser):
-    parser.addoption("--regen-golden", action="store_true", help="rewrite tests/golden/ from this adapter's renders")
+    parser.addoption("--regen-golden", action="store_true",
+                     help="rewrite tests/relief/golden/ from this adapter's renders")
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "requires_gpu: needs a wgpu adapter (skipped without one, failed in CI)")
+
+
+def pytest_runtest_setup(item):
+    if item.get_closest_marker("requires_gpu") and not adapter_summary():
+        _missing("no wgpu adapter", "install mesa-vulkan-drivers")
 
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -66,7 +78,7 @@ def adapter() -> str:
 
 @pytest.fixture(scope="session")
 def gpu(adapter):
-    from wgpuviewer.gpu import get_gpu
+    from wgpuviewer.core.gpu import get_gpu
 
     return get_gpu("auto", quiet=True)
 

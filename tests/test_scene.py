@@ -8,7 +8,8 @@ import cv2
 import numpy as np
 import pytest
 
-from wgpuviewer.errors import UserError
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.relief.techniques import TECHNIQUES
 from wgpuviewer.scene import (
     DEFAULT_LIGHT,
     Scene,
@@ -17,7 +18,6 @@ from wgpuviewer.scene import (
     load_scene,
     parse_scene,
 )
-from wgpuviewer.techniques import TECHNIQUES
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 

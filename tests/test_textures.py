@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from wgpuviewer import textures
-from wgpuviewer.errors import UserError
-from wgpuviewer.scene import TextureRef
+from wgpuviewer.core.errors import UserError
 from wgpuviewer.textures import (
     BUILTINS,
+    TextureRef,
     builtin_albedo,
     builtin_height,
     load_albedo,
@@ -46,7 +46,7 @@ def test_builtin_shape_dtype_range(name):
     a = builtin_albedo(name, (48, 40))
     assert h.shape == (40, 48) and h.dtype == np.float32
     assert a.shape == (40, 48, 3) and a.dtype == np.float32
-    assert 0 <= h.min() and h.max() <= 1 and 0 <= a.min() and a.max() <= 1
+    assert h.min() >= 0 and h.max() <= 1 and a.min() >= 0 and a.max() <= 1
     assert not h.flags.writeable and not a.flags.writeable
 
 
@@ -189,9 +189,10 @@ def test_missing_channel(tmp_path):
     rgb = write_png(tmp_path / "rgb.png", np.zeros((2, 2, 3), np.uint8))
     with pytest.raises(UserError, match=r"rgb\.png: channel 'a'.*3-channel"):
         read_image(rgb, "a")
-    grey = write_png(tmp_path / "grey.png", np.zeros((2, 2), np.uint8))
-    with pytest.raises(UserError, match=r"grey\.png: channel 'r'.*greyscale"):
-        load_height(file_ref(grey, "r"))
+    grey = write_png(tmp_path / "grey.png", np.full((2, 2), 51, np.uint8))
+    with pytest.raises(UserError, match=r"grey\.png: channel 'a'.*greyscale"):
+        load_height(file_ref(grey, "a"))
+    np.testing.assert_allclose(load_height(file_ref(grey, "r")), 0.2)  # grey: its value in every colour channel
 
 
 @pytest.mark.parametrize("bad,count", [(np.nan, 1), (np.inf, 2)])
@@ -207,7 +208,7 @@ def test_non_finite_rejected(tmp_path, bad, count):
 
 def test_float_out_of_range(tmp_path):
     np.save(tmp_path / "big.npy", np.array([[0.0, 2.5]], np.float32))
-    with pytest.raises(UserError, match=r"big\.npy: height values range from 0 to 2\.5; expected 0 to 1"):
+    with pytest.raises(UserError, match=r"big\.npy: height values range from 0 to 2\.5; expected \[0, 1\]"):
         load_height(file_ref(tmp_path / "big.npy"))
 
 

@@ -8,9 +8,9 @@ import os
 import sys
 from pathlib import Path
 
-from .errors import UserError
-from .gpu import BACKEND_CHOICES, BACKEND_ENV
-from .output import OUTPUT_MODES
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.gpu import BACKEND_CHOICES, BACKEND_ENV
+from wgpuviewer.relief.output import OUTPUT_MODES
 
 DEFAULT_SIZE = (1280, 720)
 
@@ -32,7 +32,7 @@ def load_scene_arg(path: str | None):
 
 
 def pick_technique(scene, name: str | None) -> str:
-    from .techniques import get_technique
+    from wgpuviewer.relief.techniques import get_technique
 
     return get_technique(name or scene.technique, "--technique").name
 
@@ -44,9 +44,9 @@ def has_display() -> bool:
 
 
 def cmd_render(args) -> int:
-    from .gpu import get_gpu
-    from .output import OUTPUT_SUFFIXES, save_output
-    from .renderer import Renderer
+    from wgpuviewer.core.gpu import get_gpu
+    from wgpuviewer.relief.output import OUTPUT_SUFFIXES, save_output
+    from wgpuviewer.relief.renderer import Renderer
 
     out = Path(args.output)
     if out.suffix.lower() not in OUTPUT_SUFFIXES:
@@ -61,7 +61,7 @@ def cmd_render(args) -> int:
 
 
 def cmd_view(args) -> int:
-    from .settings import load_settings
+    from wgpuviewer.viewer.settings import load_settings
 
     scripted = args.frames is not None or bool(args.screenshot)
     settings, _warnings = load_settings()  # corrupt/outdated file: defaults + a warning on stderr
@@ -77,9 +77,9 @@ def cmd_view(args) -> int:
     technique = pick_technique(scene, technique_arg)
     size = parse_size(args.size) if args.size else None
     if not window:
-        from .gpu import get_gpu
-        from .output import save_output
-        from .renderer import Renderer
+        from wgpuviewer.core.gpu import get_gpu
+        from wgpuviewer.relief.output import save_output
+        from wgpuviewer.relief.renderer import Renderer
 
         out = Path("out") / f"{Path(scene.path).stem if scene.path else 'scene'}_{technique}.png"
         print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the scene to {out} instead")
@@ -87,7 +87,7 @@ def cmd_view(args) -> int:
         save_output(out, renderer.render(technique, size or DEFAULT_SIZE), "color")
         print(out)
         return 0
-    from .viewer import run_viewer
+    from wgpuviewer.viewer.app import run_viewer
 
     keys = [k for k in args.keys.split(",") if k] if args.keys else []
     return run_viewer(
@@ -97,7 +97,7 @@ def cmd_view(args) -> int:
 
 
 def cmd_techniques(args) -> int:
-    from .techniques import TECHNIQUES
+    from wgpuviewer.relief.techniques import TECHNIQUES
 
     for t in TECHNIQUES.values():
         print(f"{t.key}  {t.name:<10} needs: {', '.join(t.textures):<22} cost: {t.cost}")
@@ -118,7 +118,8 @@ def cmd_accuracy(args) -> int:
         raise UserError(f"--texels {args.texels}: expected at least 1 texel")
     from tqdm import tqdm
 
-    from .accuracy import DEFAULT_ANGLES, DEFAULT_SETTINGS, table
+    from wgpuviewer.relief.accuracy import DEFAULT_ANGLES, DEFAULT_SETTINGS, table
+
     from .textures import BUILTINS, builtin_height
 
     for name in args.heightmaps:
@@ -126,7 +127,7 @@ def cmd_accuracy(args) -> int:
             raise UserError(f"--heightmaps: unknown builtin {name!r}; expected some of {', '.join(BUILTINS)}")
     maps = {name: builtin_height(name, (args.texels, args.texels)) for name in args.heightmaps}
     total = len(maps) * len(DEFAULT_SETTINGS) * len(DEFAULT_ANGLES)
-    from .gpu import get_gpu
+    from wgpuviewer.core.gpu import get_gpu
 
     gpu = get_gpu(args.backend)
     with tqdm(total=total, desc="probe vs reference", file=sys.stderr, leave=False) as bar:
@@ -138,7 +139,7 @@ def cmd_accuracy(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    from .bench import resolve_options, run
+    from wgpuviewer.bench.run import resolve_options, run
 
     def names(text, option):
         if text is None:
@@ -166,7 +167,7 @@ def cmd_bench(args) -> int:
                               backend=args.backend, command=command)
     out = Path(args.out)
     if args.from_csv:
-        from .bench import rereport
+        from wgpuviewer.bench.run import rereport
 
         rereport([Path(p) for p in args.from_csv], out, command)
         print(out / "report.md")
@@ -179,7 +180,7 @@ def cmd_bench(args) -> int:
 
 
 def cmd_info(args) -> int:
-    from .gpu import describe_adapters
+    from wgpuviewer.core.gpu import describe_adapters
 
     print(describe_adapters(args.backend))
     return 0

@@ -3,11 +3,12 @@
 //   dilate_h:        horizontal max over +-radius (the repeated 3x3 dilation is a (2r+1)^2 box max)
 //   dilate_v_finish: vertical max, / max, gamma, quantise to `levels`, 8-bit by truncation (stored as f32)
 // Dividing after the max equals the listing's divide-then-dilate: rounded division is monotonic.
+// #include "common/sobel.wgsl"
 
 struct Params {
     width: u32,
     height: u32,
-    border: u32,       // Sobel border (see common.wgsl)
+    border: u32,       // Sobel border (common/border.wgsl)
     ksize: u32,        // 3 or 5
     radius: u32,       // dilation radius = (kernel // 2) * iterations
     wrap_dilate: u32,  // 1: dilation wraps (repeat); 0: window clamped to the image (OpenCV default)
@@ -18,16 +19,7 @@ struct Params {
     _pad2: vec2f,
 };
 
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> src: array<f32>;
-@group(0) @binding(2) var<storage, read_write> dst: array<f32>;
 @group(0) @binding(3) var<storage, read_write> maxbits: atomic<u32>;
-
-fn h(x: i32, y: i32) -> f32 {
-    let w = i32(P.width);
-    let hh = i32(P.height);
-    return src[border_index(y, hh, P.border) * w + border_index(x, w, P.border)];
-}
 
 @compute @workgroup_size(8, 8)
 fn sobel_mag(@builtin(global_invocation_id) gid: vec3u) {

@@ -5,6 +5,7 @@
 //     near cells (offsets -1..0): 1 / G_near        if C may contain an exit point and M_q > min corner(C)
 //     far cells:                  rho / (M_q - min corner(C))   (same condition)
 //   clamped to max_ratio and multiplied by (1 - margin).  min3x3: optional 3x3 min (filter = bilinear).
+// #include "common/map_buffers.wgsl"
 
 struct Params {
     width: u32,
@@ -20,10 +21,6 @@ struct Params {
     _pad2: f32,
     _pad3: f32,
 };
-
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> src: array<f32>;
-@group(0) @binding(2) var<storage, read_write> dst: array<f32>;
 
 fn depth(i: i32, j: i32) -> f32 {
     let w = i32(P.width);

@@ -5,6 +5,7 @@
 //            max(0, d - half voxel diagonal - margin) (stored)
 // Brute force over offsets: exact, O(W + H) per voxel, loops bounded by the map size (<= the volume limit).
 // Volumes are f32 buffers indexed (k * H + j) * W + i.
+// #include "common/map_buffers.wgsl"
 
 struct Params {
     width: u32,
@@ -16,10 +17,6 @@ struct Params {
     subtract: f32,    // half voxel diagonal + rounding margin (pass_y, mode 1)
     _pad: f32,
 };
-
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> src: array<f32>;
-@group(0) @binding(2) var<storage, read_write> dst: array<f32>;
 
 @compute @workgroup_size(8, 8, 1)
 fn tops(@builtin(global_invocation_id) gid: vec3u) {

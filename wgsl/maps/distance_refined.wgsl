@@ -5,6 +5,7 @@
 // of the (1 + alpha)-Lipschitz gap), then a backward visibility test: (c, s) is occluded only if some sample
 // c - L s has lower(dF') > eps + L*alpha. Value = max(euclid - eps, min over admissible l_s) - margin, >= 0.
 // Loops: directions <= ndirs, forward <= FORWARD_STEPS, backward <= BACKWARD_SAMPLES.
+// #include "common/border.wgsl"
 
 const FORWARD_STEPS: u32 = 48u;     // = distance.REFINE_FORWARD_STEPS
 const BACKWARD_SAMPLES: u32 = 24u;  // = distance.REFINE_BACKWARD_SAMPLES

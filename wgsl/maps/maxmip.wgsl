@@ -2,6 +2,7 @@
 // Parent i covers children floor(i*n/p) .. min(2i+1, n-1): a superset of both the index-space
 // children 2i..2i+1 (clamped) and every child its UV span overlaps, so it stays conservative for
 // odd and non-square sizes.
+// #include "common/map_buffers.wgsl"
 
 struct Params {
     src_w: u32,
@@ -9,10 +10,6 @@ struct Params {
     dst_w: u32,
     dst_h: u32,
 };
-
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> src: array<f32>;
-@group(0) @binding(2) var<storage, read_write> dst: array<f32>;
 
 @compute @workgroup_size(8, 8)
 fn reduce(@builtin(global_invocation_id) gid: vec3u) {

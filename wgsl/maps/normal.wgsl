@@ -1,6 +1,7 @@
 // Normal map from a height map: Sobel 3x3 gradients, unit normals, three f32 per texel.
 // n = normalize(-s * dH/du, ysign * s * dH/drow, 1), dH/d* = Sobel / 8 (height units per texel).
 // ysign = +1 for the OpenGL convention (y towards row 0, "green up"), -1 for DirectX (y towards +row).
+// #include "common/sobel.wgsl"
 
 struct Params {
     width: u32,
@@ -11,16 +12,6 @@ struct Params {
     ysign: f32,
     _pad2: vec2f,
 };
-
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> src: array<f32>;
-@group(0) @binding(2) var<storage, read_write> dst: array<f32>;
-
-fn h(x: i32, y: i32) -> f32 {
-    let w = i32(P.width);
-    let hh = i32(P.height);
-    return src[border_index(y, hh, P.border) * w + border_index(x, w, P.border)];
-}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

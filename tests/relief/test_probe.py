@@ -1,0 +1,130 @@
+"""The GPU probe (the techniques' WGSL trace functions) against the float64 reference."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.relief.accuracy import measure, random_rays
+from wgpuviewer.relief.probe import probe
+from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
+from wgpuviewer.textures import builtin_height
+
+REAL = ("bricks", "bumps", "ridges")
+HARD = ("flat0", "flat1", "spike", "step", "wall", "checker")
+RAY_SEARCH = (("parallax", {}), ("parallax", {"offset_limiting": True}), ("steep", {"layers": 32}), ("pom", {"layers": 32}))
+
+
+def height_map(name: str, size=(128, 128)) -> np.ndarray:
+    return builtin_height(name, size)
+
+
+@pytest.mark.parametrize("name", REAL + HARD)
+@pytest.mark.parametrize("angle", [0, 30, 45, 60, 75, 80])
+def test_pom_256_layers_within_half_a_texel(gpu, name, angle):
+    acc = measure("pom", height_map(name), angle, height_scale=0.05, rays=1024, layers=256)
+    assert acc.capped == 0.0
+    assert acc.error_p95 <= 0.5, acc
+
+
+@pytest.mark.parametrize("name", ["bumps", "ridges"])
+def test_pom_error_falls_with_layers(gpu, name):
+    errors = [measure("pom", height_map(name), 60, rays=1024, layers=n).error_p95 for n in (4, 16, 64)]
+    assert errors[0] > errors[1] > errors[2], errors
+
+
+def test_steep_error_within_one_layer_step(gpu):
+    """Steep parallax returns the first layer below the surface: on a smooth map at most one step late."""
+    h = height_map("bumps")
+    layers, angle, scale = 16, 45.0, 0.05
+    acc = measure("steep", h, angle, height_scale=scale, rays=1024, layers=layers)
+    step_texels = np.tan(np.radians(angle)) * scale * h.shape[1] / layers
+    assert acc.error_p95 <= step_texels * 1.01, (acc.error_p95, step_texels)
+    assert acc.error_p95 > step_texels * 0.05  # and it is a real, measurable error
+
+
+@pytest.mark.parametrize("technique,params", RAY_SEARCH + (("pom", {"layers": 256}),))
+@pytest.mark.parametrize("name", REAL + HARD)
+@pytest.mark.parametrize("angle", [85.0, 89.0, 89.9])
+def test_grazing_views_are_finite(gpu, technique, params, name, angle):
+    uv, view = random_rays(256, angle)
+    got = probe(technique, height_map(name, (64, 64)), uv, view, 0.05, **params)
+    assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all()
+    assert ((got.depth >= 0) & (got.depth <= 1)).all()
+
+
+@pytest.mark.parametrize("technique,params", RAY_SEARCH)
+def test_horizontal_and_back_facing_views_are_finite_and_flagged(gpu, technique, params):
+    views = np.array([[1.0, 0.0, 0.0], [0.6, 0.8, 0.0], [0.0, 0.6, -0.8], [0.0, 0.0, -1.0], [1.0, 0.0, 1e-7]])
+    got = probe(technique, height_map("bumps", (64, 64)), np.full((len(views), 2), 0.3), views, 0.05, **params)
+    assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all()
+    expect_capped = not params.get("offset_limiting", False)  # limited offsets need no clamp
+    assert (got.capped == expect_capped).all()
+    ref = exact_hit(1.0 - height_map("bumps", (64, 64)), np.full((len(views), 2), 0.3), views, 0.05)
+    assert not ref.valid.any()  # the reference declines these rays rather than guessing
+
+
+@pytest.mark.parametrize("technique,params", RAY_SEARCH)
+def test_fetch_counts_follow_the_layer_count(gpu, technique, params):
+    uv, view = random_rays(512, 60)
+    got = probe(technique, height_map("checker", (64, 64)), uv, view, 0.05, **params)
+    limit = params.get("layers", 0) + 1
+    if technique == "parallax":
+        assert (got.fetches == 1).all()
+    else:
+        assert got.fetches.min() >= 1 and got.fetches.max() <= limit
+
+
+def test_flat_maps_hit_exactly(gpu):
+    uv, view = random_rays(256, 70)
+    top = probe("pom", np.ones((16, 16)), uv, view, 0.05, layers=8)  # height 1: depth 0 everywhere
+    assert np.allclose(top.uv, uv, atol=1e-6) and (top.depth == 0).all() and (top.fetches == 1).all()
+    bottom = probe("pom", np.zeros((16, 16)), uv, view, 0.05, layers=8)  # depth 1: hit at t = 1
+    expected = uv - view[:, :2] / view[:, 2:3] * 0.05
+    assert np.allclose(bottom.uv, expected, atol=1e-5) and np.allclose(bottom.depth, 1.0)
+
+
+def test_npot_and_single_texel_maps(gpu):
+    rng = np.random.default_rng(1)
+    h = np.clip(0.5 + 0.2 * np.sin(np.arange(401)[:, None] / 9.0) * np.cos(np.arange(343)[None, :] / 7.0), 0, 1)
+    acc = measure("pom", h, 60, rays=1024, layers=256)
+    assert acc.error_p95 <= 0.5
+    one = probe("pom", np.full((1, 1), 0.25), rng.random((64, 2)), view_dir_from_angles(np.full(64, 50.0), 0.0), 0.1)
+    expected_t = 0.75
+    assert np.allclose(one.depth, expected_t, atol=1.5 / 16)  # default 16 layers, then interpolation
+    ref = exact_hit(np.full((1, 1), 0.75), one.uv * 0 + 0.5, view_dir_from_angles(50.0, 0.0), 0.1)
+    assert np.allclose(ref.t, expected_t)
+
+
+@pytest.mark.parametrize("scale", [1e-4, 1.0])
+def test_extreme_height_scales(gpu, scale):
+    h = height_map("bumps", (64, 64))
+    uv, view = random_rays(512, 60)
+    got = probe("pom", h, uv, view, scale, layers=64)
+    assert np.isfinite(got.uv).all()
+    ref = exact_hit(1.0 - h, uv, view, scale)
+    err = uv_error_texels(got.uv, ref.uv, (64, 64))
+    # tiny relief: everything is within a hundredth of a texel; huge relief: POM 64 stays bounded
+    assert np.percentile(err, 95) <= (0.01 if scale < 1e-3 else 3.0)
+
+
+def test_clamp_addressing_matches_reference(gpu):
+    h = height_map("step", (32, 32))
+    uv, view = random_rays(512, 60, seed=3)
+    got = probe("pom", h, uv, view, 0.05, address="clamp", layers=256)
+    ref = exact_hit(1.0 - h, uv, view, 0.05, address="clamp")
+    err = np.hypot(*((got.uv - ref.uv) * 32).T)  # no wrap: clamp addressing has no periodicity
+    assert np.percentile(err, 95) <= 0.5
+
+
+def test_probe_rejects_bad_input(gpu):
+    h = np.ones((8, 8))
+    with pytest.raises(UserError, match="does not trace rays"):
+        probe("basic", h, [0.5, 0.5], [0, 0, 1])
+    with pytest.raises(UserError, match="layers"):
+        probe("pom", h, [0.5, 0.5], [0, 0, 1], layers=0)
+    with pytest.raises(UserError, match="NaN"):
+        probe("pom", np.full((8, 8), np.nan), [0.5, 0.5], [0, 0, 1])
+    with pytest.raises(UserError, match="unknown technique"):
+        probe("nope", h, [0.5, 0.5], [0, 0, 1])

@@ -1,0 +1,266 @@
+"""The ray-search techniques of issue #4 (pom_adaptive, relief, maxmip, distance, distance_refined): what each
+one promises, measured with the GPU probe against the float64 reference."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from maptools.cache import cached_generate
+from maptools.cpu import level_sizes
+from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
+from wgpuviewer.relief.maps import cell_max_height, maxmip_atlas
+from wgpuviewer.relief.output import OUTPUT_MODES, mode_data, mode_picture
+from wgpuviewer.relief.probe import probe
+from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
+from wgpuviewer.relief.renderer import Renderer
+from wgpuviewer.relief.techniques import REFINED_MAX_ANGLE, TECHNIQUES
+from wgpuviewer.scene import default_scene_path, load_scene
+from wgpuviewer.textures import builtin_height
+
+REAL = ("bricks", "bumps", "ridges")
+HARD = ("flat0", "flat1", "spike", "step", "wall", "checker")
+EXACT = ("maxmip", "distance", "distance_refined")  # first hit of the bilinear surface, float32 precision
+NEW = (("pom_adaptive", {}), ("pom_adaptive", {"angle_only": True}), ("relief", {}),
+       ("maxmip", {}), ("distance", {}), ("distance_refined", {}))
+#: Float tolerance for "no hit behind the true first hit", in layer depth t (float32 positions and depths).
+T_TOL = 1e-4
+
+
+def height_map(name: str, size=(64, 64)) -> np.ndarray:
+    return builtin_height(name, size)
+
+
+# --- pom_adaptive: the thesis' layer counts, as the shader uses them ---------------------------------------
+
+def thesis_layers(angle_deg: float, c: float, nmin=4, nmax=32) -> int:
+    f = (1.0 - abs(math.cos(math.radians(angle_deg)))) ** 0.8
+    nt_min = nmin + (nmax / 2 - nmin) * f
+    nt_max = nmin + (nmax - nmin) * f
+    return int(nt_min + (nt_max - nt_min) * c)
+
+
+@pytest.mark.parametrize("angle,f,n_range", [(0, 0.0, (4, 4)), (45, 0.3744, (8, 14)), (80, 0.8585, (14, 28))])
+def test_pom_adaptive_reproduces_thesis_table_2_2(gpu, angle, f, n_range):
+    """Table 2.2 of the thesis: the layer counts the shader actually uses on a C = 0 map (flat: no gradients)
+    and a C = 1 map (checkerboard: gradients everywhere after dilation), for random azimuths."""
+    assert round((1 - math.cos(math.radians(angle))) ** 0.8, 4) == f
+    uv, view = random_rays(256, angle, seed=2)
+    for name, c, expected in (("flat0", 0.0, n_range[0]), ("checker", 1.0, n_range[1])):
+        h = height_map(name)
+        assert (cached_generate("complexity", h, backend="auto", border="repeat") == round(c * 255)).all()
+        got = probe("pom_adaptive", h, uv, view, 0.05)
+        assert (got.layers == expected).all(), (name, np.unique(got.layers))
+        assert thesis_layers(angle, c) == expected
+        assert got.fetches.max() <= expected + 1
+
+
+def test_pom_adaptive_layers_follow_the_formula_at_every_angle(gpu):
+    """N = int(mix(NTmin, NTmax, C)) (truncation) for angles 0-89.9 degrees, C in {0, 1}; values within 1e-3 of
+    an integer are skipped (float32 vs float64 may round them either way)."""
+    angles = np.linspace(0.0, 89.9, 200)
+    uv = np.full((len(angles), 2), 0.4)
+    view = view_dir_from_angles(angles, 30.0)
+    for name, c in (("flat0", 0.0), ("checker", 1.0)):
+        got = probe("pom_adaptive", height_map(name), uv, view, 0.05)
+        for a, n in zip(angles, got.layers):
+            f = (1.0 - math.cos(math.radians(a))) ** 0.8
+            exact = 4 + (16 - 4) * f + ((4 + 28 * f) - (4 + 12 * f)) * c
+            if abs(exact - round(exact)) > 1e-3:
+                assert n == int(exact), (a, c, n, exact)
+
+
+def test_pom_adaptive_angle_only_variant(gpu):
+    """three.js / Godot: N = int(mix(Nmax, Nmin, |V.z|)), the complexity map ignored."""
+    angles = np.array([0.0, 30.0, 45.0, 55.0, 80.0, 89.0])  # none lands on an integer N (60: exactly 20)
+    view = view_dir_from_angles(angles, 0.0)
+    uv = np.full((len(angles), 2), 0.3)
+    for name in ("flat0", "checker"):
+        got = probe("pom_adaptive", height_map(name), uv, view, 0.05, angle_only=True, min_layers=8, max_layers=32)
+        expected = [int(32 + (8 - 32) * math.cos(math.radians(a))) for a in angles]
+        assert list(got.layers) == expected
+
+
+def test_pom_adaptive_is_pom_with_its_layer_count(gpu):
+    """Same search as pom: with Nmin = Nmax = 24 the results equal pom with 24 layers bit for bit."""
+    h = height_map("bumps")
+    uv, view = random_rays(512, 60, seed=5)
+    a = probe("pom_adaptive", h, uv, view, 0.05, min_layers=24, max_layers=24, angle_only=True)
+    b = probe("pom", h, uv, view, 0.05, layers=24)
+    assert (a.layers == 24).all() and (b.layers == 24).all()
+    assert np.array_equal(a.uv, b.uv) and np.array_equal(a.fetches, b.fetches)
+
+
+# --- relief ------------------------------------------------------------------------------------------------
+
+def test_relief_binary_steps_shrink_the_error(gpu):
+    h = height_map("bumps", (128, 128))
+    errors = [measure("relief", h, 60, rays=1024, linear_steps=16, binary_steps=b).error_p95 for b in (0, 2, 6)]
+    assert errors[0] > 2 * errors[1] > 0 and errors[1] > 2 * errors[2], errors
+    step_texels = math.tan(math.radians(60)) * 0.05 * 128 / 16
+    assert errors[2] <= step_texels / 2**6 * 1.01
+
+
+def test_relief_without_binary_steps_is_steep(gpu):
+    h = height_map("ridges")
+    uv, view = random_rays(512, 50, seed=4)
+    a = probe("relief", h, uv, view, 0.05, linear_steps=16, binary_steps=0)
+    b = probe("steep", h, uv, view, 0.05, layers=16)
+    assert np.allclose(a.uv, b.uv, atol=1e-5) and np.array_equal(a.fetches, b.fetches)
+
+
+@pytest.mark.parametrize("linear,binary", [(1, 0), (8, 3), (16, 6), (64, 10)])
+def test_relief_fetch_bound(gpu, linear, binary):
+    uv, view = random_rays(512, 70)
+    got = probe("relief", height_map("checker"), uv, view, 0.05, linear_steps=linear, binary_steps=binary)
+    assert got.fetches.min() >= 1 and got.fetches.max() <= linear + 1 + binary
+    assert (got.layers == linear).all()
+
+
+# --- exact tracers: maxmip, distance, distance_refined -------------------------------------------------------
+
+@pytest.mark.parametrize("technique", EXACT)
+@pytest.mark.parametrize("name", REAL + HARD)
+def test_exact_tracers_find_the_first_hit(gpu, technique, name):
+    """Float32-exact first hit at 0-85 degrees: never behind the reference hit (no tunnelling through thin walls
+    or spikes), and on the reference surface to a small fraction of a texel."""
+    h = height_map(name)
+    ref_depth = 1.0 - h
+    for angle in (0, 60, 80, 85):
+        uv, view = random_rays(512, angle, seed=angle)
+        got = probe(technique, h, uv, view, 0.05)
+        ref = exact_hit(ref_depth, uv, view, 0.05)
+        ok = ~got.capped
+        assert ok.mean() >= 0.99, (angle, ok.mean())
+        assert (got.depth[ok] <= ref.t[ok] + T_TOL).all(), (angle, float(np.max(got.depth[ok] - ref.t[ok])))
+        err = uv_error_texels(got.uv[ok], ref.uv[ok], (64, 64))
+        assert np.percentile(err, 99) <= 0.01 and err.max() <= 0.5, (angle, float(err.max()))
+
+
+@pytest.mark.parametrize("technique", EXACT)
+def test_exact_tracers_on_npot_and_single_texel_maps(gpu, technique):
+    h = npot_height()
+    uv, view = random_rays(1024, 70, seed=9)
+    got = probe(technique, h, uv, view, 0.05)
+    ref = exact_hit(1.0 - h, uv, view, 0.05)
+    assert not got.capped.any()
+    assert (got.depth <= ref.t + T_TOL).all()
+    assert uv_error_texels(got.uv, ref.uv, (343, 401)).max() <= 0.01
+    one = probe(technique, np.full((1, 1), 0.25), uv, view, 0.1)
+    assert np.allclose(one.depth, 0.75, atol=1e-5) and not one.capped.any()
+
+
+@pytest.mark.parametrize("technique", EXACT)
+def test_exact_tracers_at_89_degrees(gpu, technique):
+    """Very grazing rays walk many cells: the cap may stop some (flagged), but none passes a surface."""
+    h = height_map("wall")
+    uv, view = random_rays(512, 89.0, seed=1)
+    got = probe(technique, h, uv, view, 0.05)
+    ref = exact_hit(1.0 - h, uv, view, 0.05)
+    assert (got.depth <= ref.t + T_TOL).all()  # capped rays stop short, never behind
+    ok = ~got.capped
+    assert ok.mean() > 0.5
+    assert uv_error_texels(got.uv[ok], ref.uv[ok], (64, 64)).max() <= 0.05
+
+
+def test_capped_rays_stop_short_and_are_flagged(gpu):
+    h = height_map("bumps")
+    uv, view = random_rays(512, 80, seed=3)
+    ref = exact_hit(1.0 - h, uv, view, 0.05)
+    for technique, params in (("maxmip", {"max_steps": 3}), ("distance", {"iterations": 2})):
+        got = probe(technique, h, uv, view, 0.05, **params)
+        assert got.capped.mean() > 0.5
+        assert (got.depth <= ref.t + T_TOL).all()
+
+
+def test_maxmip_pyramid_bounds_every_cell_it_covers():
+    """Node i of level m bounds the cells [i 2^m, (i+1) 2^m) (ceil-halving levels, odd sizes included), and the
+    atlas rows are where maxmip.wgsl looks for them."""
+    rng = np.random.default_rng(0)
+    depth = rng.random((13, 7))
+    cells = cell_max_height(depth)
+    h = 1.0 - depth
+    brute = np.max([np.roll(h, (-dy, -dx), axis=(0, 1)) for dy in (0, 1) for dx in (0, 1)], axis=0)
+    assert np.array_equal(cells, brute.astype(np.float32))
+    levels = cached_generate("maxmip", cells, backend="cpu")
+    assert [lv.shape for lv in levels] == level_sizes(13, 7)
+    for m, level in enumerate(levels):
+        for j in range(level.shape[0]):
+            for i in range(level.shape[1]):
+                block = cells[j << m:(j + 1) << m, i << m:(i + 1) << m]
+                assert level[j, i] >= block.max()
+    atlas = maxmip_atlas(levels)
+    row = 0
+    for level in levels:
+        assert np.array_equal(atlas[row:row + level.shape[0], :level.shape[1]], level)
+        row += level.shape[0]
+
+
+def test_distance_refined_uses_the_same_tracer():
+    plain, refined = TECHNIQUES["distance"], TECHNIQUES["distance_refined"]
+    assert plain.wgsl_file == refined.wgsl_file == "techniques/distance.wgsl"
+    assert plain.params == refined.params
+    assert dict(refined.fixed)["cone_cos"] == pytest.approx(math.cos(math.radians(REFINED_MAX_ANGLE)))
+
+
+def test_distance_refined_fetches_against_plain(gpu):
+    """Equal error (both exact); the refined map may only save fetches inside its view cone."""
+    h = height_map("bricks")
+    for angle in (30, 60, 80):
+        plain = measure("distance", h, angle, rays=1024)
+        refined = measure("distance_refined", h, angle, rays=1024)
+        assert plain.error_p95 <= 0.01 and refined.error_p95 <= 0.01
+        assert refined.fetches_mean <= plain.fetches_mean * 1.02, (angle, refined, plain)
+
+
+# --- all new techniques: bounded and flagged at grazing and back-facing views --------------------------------
+
+@pytest.mark.parametrize("technique,params", NEW)
+@pytest.mark.parametrize("name", ("bumps", "spike", "checker"))
+def test_new_techniques_finite_at_grazing_views(gpu, technique, params, name):
+    for angle in (85.0, 89.0, 89.9):
+        uv, view = random_rays(256, angle)
+        got = probe(technique, height_map(name), uv, view, 0.05, **params)
+        assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all()
+        assert ((got.depth >= 0) & (got.depth <= 1)).all()
+
+
+@pytest.mark.parametrize("technique,params", NEW)
+def test_new_techniques_flag_horizontal_and_back_facing_views(gpu, technique, params):
+    views = np.array([[1.0, 0.0, 0.0], [0.6, 0.8, 0.0], [0.0, 0.6, -0.8], [0.0, 0.0, -1.0], [1.0, 0.0, 1e-7]])
+    got = probe(technique, height_map("bumps"), np.full((len(views), 2), 0.3), views, 0.05, **params)
+    assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all()
+    assert got.capped.all()
+
+
+# --- rendering ----------------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def scene_renderer(gpu):
+    return Renderer(load_scene(default_scene_path()), gpu)
+
+
+def test_layers_mode_shows_the_adaptive_layer_count(scene_renderer):
+    assert "layers" in OUTPUT_MODES
+    image = scene_renderer.render("pom_adaptive", (128, 72))
+    layers = mode_data(image, "layers")
+    drawn = layers[image.covered]
+    assert drawn.min() >= 4 and drawn.max() <= 32 and len(np.unique(drawn)) > 3
+    assert np.isnan(layers[~image.covered]).all()
+    grey = mode_picture(image, "layers")
+    expected = np.rint(np.clip((drawn - 4) / 28, 0, 1) * 255)
+    assert np.array_equal(grey[image.covered][:, 0], expected.astype(np.uint8))
+    fixed = mode_data(scene_renderer.render("relief", (64, 36)), "layers")
+    assert set(np.unique(fixed[np.isfinite(fixed)])) == {16.0}
+
+
+def test_cost_scale_bounds_each_search():
+    """The cost view's full heat: the fetch bound of layer searches, a common scale otherwise."""
+    from wgpuviewer.relief.techniques import COMMON_COST_SCALE, TECHNIQUES
+
+    assert TECHNIQUES["pom"].cost_scale({"layers": 32}) == 33
+    assert TECHNIQUES["pom_adaptive"].cost_scale(TECHNIQUES["pom_adaptive"].defaults()) == 33
+    assert TECHNIQUES["relief"].cost_scale({"linear_steps": 16, "binary_steps": 6}) == 23
+    assert TECHNIQUES["maxmip"].cost_scale(TECHNIQUES["maxmip"].defaults()) == COMMON_COST_SCALE

@@ -1,0 +1,191 @@
+"""The window: scripted sessions under a (virtual) X display (glfw, the adapter wgpu picks).
+
+Each run is a real window replaying keys one per frame; runs are shared between tests (module
+cache) and kept small (320x200, 4 frames) so the whole file stays within a few seconds per run.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import cv2
+import numpy as np
+import pytest
+
+# Log records go to stderr as "LEVEL name: message", so ERRORs from wgpu/rendercanvas are visible.
+RUNNER = (
+    "import logging, sys; logging.basicConfig(level=logging.WARNING, format='%(levelname)s %(name)s: %(message)s');"
+    "from wgpuviewer.cli import main; sys.exit(main(sys.argv[1:]))"
+)
+SMALL = "320x200"
+
+
+class Run:
+    def __init__(self, image: np.ndarray, stderr: str, cwd):
+        self.image, self.stderr, self.cwd = image, stderr, cwd
+
+
+@pytest.fixture(scope="module")
+def runs(display, adapter, tmp_path_factory):
+    """``runs(name, keys, size=SMALL, settings_text=None)`` -> Run, each distinct run made once."""
+    cache = {}
+
+    def run(name: str, keys: str, size: str = SMALL, settings_text: str | None = None) -> Run:
+        if name in cache:
+            return cache[name]
+        work = tmp_path_factory.mktemp(name)
+        config = work / "config"
+        config.mkdir()
+        if settings_text is not None:
+            (config / "settings.toml").write_text(settings_text)
+        shot = work / f"{name}.png"
+        result = subprocess.run(
+            [sys.executable, "-c", RUNNER, "view", "--size", size, "--frames", str(len(keys.split(",")) + 2),
+             "--screenshot", str(shot), "--keys", keys],
+            capture_output=True, text=True, timeout=300, cwd=work,
+            env={**os.environ, "DISPLAY": display, "WGPUVIEWER_CONFIG_DIR": str(config)},
+        )
+        assert result.returncode == 0, result.stderr
+        errors = [line for line in result.stderr.splitlines() if line.startswith("ERROR")]
+        assert not errors, errors
+        image = cv2.imread(str(shot))
+        assert image is not None and image.shape[2] == 3
+        assert not (config / "settings.toml").exists() or settings_text is not None  # scripted: no save
+        cache[name] = Run(cv2.cvtColor(image, cv2.COLOR_BGR2RGB).astype(np.int16), result.stderr, work)
+        return cache[name]
+
+    return run
+
+
+def test_keys_switch_techniques(runs):
+    basic = runs("basic", "H,1,P").image  # H hides the HUD: pure scene pixels
+    pom = runs("pom", "H,5").image
+    normal = runs("normal", "H,2").image
+    cycled = runs("cycled", "H,1,ArrowRight").image
+    assert np.abs(basic - pom).mean() > 1.0
+    assert np.abs(basic - normal).mean() > 0.1
+    assert np.abs(cycled - normal).max() == 0  # Right from technique 1 is technique 2
+    assert (basic.std(axis=(0, 1)) > 5).all()  # a real picture, not a blank frame
+
+
+def test_screenshot_key_writes_png(runs):
+    run = runs("basic", "H,1,P")
+    shots = list(run.cwd.glob("wgpuviewer-*-basic-*.png"))
+    assert len(shots) == 1, run.stderr
+    assert f"screenshot: {shots[0]}" in run.stderr
+    image = cv2.imread(str(shots[0]))
+    assert image.shape[:2] == (200, 320) and image.std() > 5
+
+
+def test_cost_and_error_views(runs):
+    pom = runs("pom", "H,5").image
+    cost = runs("cost", "H,5,D").image
+    error = runs("error", "H,5,E").image
+    assert np.abs(pom - cost).mean() > 5
+    assert np.abs(pom - error).mean() > 5
+    # Heat colours: red >= green >= blue wherever the error map painted something.
+    painted = np.abs(error - pom).sum(axis=2) > 30
+    assert painted.mean() > 0.2
+    r, g, b = (error[painted][:, i] for i in range(3))
+    assert (r >= g - 2).mean() > 0.95 and (g >= b - 2).mean() > 0.95
+
+
+def test_hud_appears_and_h_hides_it_and_corrupt_settings_are_survived(runs):
+    hidden = runs("pom", "H,5").image
+    # The HUD run also starts from a corrupt settings file: defaults, a warning, no crash.
+    hud = runs("hud", "5", settings_text="width = = [broken\n")
+    assert "corrupt" in hud.stderr and "using default settings" in hud.stderr
+    changed = np.abs(hud.image - hidden).sum(axis=2) > 30
+    assert changed[:60, :110].mean() > 0.2  # the statistics panel, top left
+    assert changed[:60, -110:].mean() > 0.2  # the technique panel, top right
+    assert changed[170:, :140].mean() < 0.2  # the scene itself shows below the panels
+
+
+def test_split_view_shows_two_techniques(runs):
+    basic = runs("basic", "H,1,P").image
+    pom = runs("pom", "H,5").image
+    split = runs("split", "H,1,B,Tab,5").image  # A = basic, Tab makes B active, 5 = pom on the right
+    left, right = slice(0, 150), slice(170, 320)
+    assert np.abs(split[:, left] - basic[:, left]).mean() < 0.5
+    assert np.abs(split[:, right] - pom[:, right]).mean() < 0.5
+    assert np.abs(split[:, right] - basic[:, right]).mean() > 1.0
+
+
+def test_interactive_session_saves_its_settings(display, adapter, tmp_path):
+    code = (
+        "import sys; from wgpuviewer.viewer.app import run_viewer; from wgpuviewer.scene import *;"
+        "sys.exit(run_viewer(load_scene(default_scene_path()), 'steep', frames=3, keys=['H', 'O'],"
+        " size=(320, 200), save=True))"
+    )
+    env = {**os.environ, "DISPLAY": display, "WGPUVIEWER_CONFIG_DIR": str(tmp_path)}
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
+    assert result.returncode == 0, result.stderr
+    from wgpuviewer.scene import default_scene_path
+    from wgpuviewer.viewer.settings import load_settings
+
+    saved, warnings = load_settings(tmp_path / "settings.toml")
+    assert warnings == []
+    assert (saved.width, saved.height) == (320, 200)
+    assert saved.camera_mode == "orbit" and saved.show_hud is False
+    assert saved.last_technique == "steep" and saved.last_scene == str(default_scene_path())
+
+
+BROKEN_RELOAD = """
+import sys
+from wgpuviewer.core import wgsl
+from wgpuviewer.scene import default_scene_path, load_scene
+from wgpuviewer.viewer.app import run_viewer
+
+good, reads = wgsl.read_wgsl, []
+
+def edited(name):  # pom.wgsl reads fine once (the first build), then is "edited" into an error
+    if name != "techniques/pom.wgsl":
+        return good(name)
+    reads.append(name)
+    return good(name) + ("\\nfn oops() -> f32 { return 1.0 +; }\\n" if len(reads) > 1 else "")
+
+wgsl.read_wgsl = edited
+sys.exit(run_viewer(load_scene(default_scene_path()), "basic", frames=4, keys=["5", "F5"], size=(320, 200),
+                    screenshot=sys.argv[1]))
+"""
+
+
+def test_broken_shader_edit_keeps_the_window_drawing(display, adapter, tmp_path):
+    # The window's reload path: F5 rebuilds pom's pipeline from a broken source; the old one keeps drawing.
+    shot = tmp_path / "broken.png"
+    env = {**os.environ, "DISPLAY": display, "WGPUVIEWER_CONFIG_DIR": str(tmp_path)}
+    result = subprocess.run([sys.executable, "-c", BROKEN_RELOAD, str(shot)], capture_output=True, text=True,
+                            timeout=300, env=env)
+    assert result.returncode == 0, result.stderr
+    lines = [line for line in result.stderr.splitlines() if line.startswith("shader error: techniques/pom.wgsl:")]
+    assert len(lines) == 1 and "expected" in lines[0], result.stderr
+    image = cv2.imread(str(shot))
+    assert image is not None and image.std() > 5
+
+
+def test_missing_qt_is_a_clear_error(monkeypatch, tmp_path, capsys):
+    import importlib.util
+
+    if any(importlib.util.find_spec(qt) for qt in ("PySide6", "PyQt6", "PySide2", "PyQt5")):
+        pytest.skip("a Qt binding is installed")
+    from wgpuviewer.cli import main
+
+    monkeypatch.setenv("DISPLAY", ":0")  # no window is opened: the toolkit check comes first
+    monkeypatch.setenv("WGPUVIEWER_CONFIG_DIR", str(tmp_path))
+    assert main(["view", "--gui", "qt", "--frames", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wgpuviewer: error: --gui qt:") and "pip install PySide6" in err
+
+
+def test_scripted_run_errors_end_the_run(display, tmp_path, adapter):
+    """A failure inside a frame (here: an unwritable screenshot path) ends a scripted run with one line
+    and exit 2 instead of redrawing forever; unknown keys are refused up front."""
+    env = {**os.environ, "DISPLAY": display, "WGPUVIEWER_CONFIG_DIR": str(tmp_path)}
+    base = [sys.executable, "-m", "wgpuviewer", "view", "--size", "160x100", "--frames", "2"]
+    result = subprocess.run([*base, "--screenshot", "/proc/no/such/shot.png"], capture_output=True, text=True,
+                            timeout=120, env=env)
+    assert result.returncode == 2 and "cannot write" in result.stderr and "Traceback" not in result.stderr
+    result = subprocess.run([*base, "--keys", "Nope"], capture_output=True, text=True, timeout=120, env=env)
+    assert result.returncode == 2 and "--keys: unknown key 'Nope'" in result.stderr

@@ -1,0 +1,388 @@
+"""report.md and plots of a benchmark run (run.py)."""
+
+from __future__ import annotations
+
+import io
+import math
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+BUDGETS = (0.25, 0.5, 1.0)  # texels, p95 UV error
+HEADLINE_MAX_ANGLE = 80.0  # the headline asks for the budget at every angle up to this
+
+#: Thesis Table 4.1 (papers.md, 002): FPS per angle for POM 4/8/16/24/32 layers and adaptive 4-32.
+THESIS_ANGLES = (0.0, 45.0, 60.0, 80.0)
+THESIS_LAYERS = (4, 8, 16, 24, 32)
+THESIS_FPS = {
+    0.0: (1294, 866, 418, 280, 207, 978),
+    45.0: (571, 265, 121, 80, 62, 162),
+    60.0: (670, 301, 150, 102, 76, 169),
+    80.0: (1351, 735, 345, 247, 185, 332),
+}
+ADAPTIVE = "pom_adaptive"
+
+
+def _key(v: dict) -> tuple[str, str]:
+    return v["technique"], v["params"]
+
+
+def _label(key) -> str:
+    technique, params = key
+    return technique if params == "-" else f"{technique} {params}"
+
+
+def _f(x, digits=2) -> str:
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "n/a"
+    return f"{x:.{digits}f}"
+
+
+def _geomean(xs) -> float:
+    xs = [x for x in xs if x > 0 and math.isfinite(x)]
+    return float(np.exp(np.mean(np.log(xs)))) if xs else float("nan")
+
+
+def _layers(params: str) -> int | None:
+    for part in params.split():
+        if part.startswith("layers="):
+            return int(part.split("=")[1])
+    return None
+
+
+# --- headline ---------------------------------------------------------------------------------
+
+def headline(values: list[dict], max_angle: float = HEADLINE_MAX_ANGLE) -> list[dict]:
+    """Per budget: the configuration with the lowest geometric-mean time ratio to basic among those
+    whose p95 UV error is within the budget in every measurement (height map x angle <= max_angle)."""
+    by_config = defaultdict(list)
+    for v in values:
+        if v["angle"] <= max_angle:
+            by_config[_key(v)].append(v)
+    out = []
+    for budget in BUDGETS:
+        best = None
+        for key, vs in by_config.items():
+            if all(v["uv_err_p95"] <= budget for v in vs):  # NaN (no pixel evaluated) fails
+                ratio = _geomean(v["ratio_to_basic"] for v in vs)
+                fetches = float(np.mean([v["fetches_mean"] for v in vs]))
+                worst = max(v["uv_err_p95"] for v in vs)
+                if best is None or ratio < best["ratio"]:
+                    best = {"budget": budget, "config": key, "ratio": ratio, "fetches": fetches, "worst_p95": worst,
+                            "cases": len(vs)}
+        out.append(best or {"budget": budget, "config": None})
+    return out
+
+
+def per_angle_budget(values: list[dict]) -> dict:
+    """(budget, angle) -> (config, ratio) cheapest with p95 <= budget on every height map at that angle."""
+    groups = defaultdict(lambda: defaultdict(list))
+    for v in values:
+        groups[v["angle"]][_key(v)].append(v)
+    out = {}
+    for angle, configs in groups.items():
+        for budget in BUDGETS:
+            best = None
+            for key, vs in configs.items():
+                if all(v["uv_err_p95"] <= budget for v in vs):
+                    ratio = _geomean(v["ratio_to_basic"] for v in vs)
+                    if best is None or ratio < best[1]:
+                        best = (key, ratio)
+            out[budget, angle] = best
+    return out
+
+
+# --- Table 4.1 --------------------------------------------------------------------------------
+
+def _thesis_configs(values):
+    """POM rows of the thesis' layer counts and the adaptive rows, per (heightmap, angle)."""
+    table = defaultdict(dict)
+    for v in values:
+        if v["angle"] not in THESIS_ANGLES:
+            continue
+        if v["technique"] == "pom" and _layers(v["params"]) in THESIS_LAYERS:
+            table[v["heightmap"], v["angle"]][f"POM {_layers(v['params'])}"] = v
+        elif v["technique"] == ADAPTIVE:
+            table[v["heightmap"], v["angle"]].setdefault("adaptive", v)
+    return table
+
+
+def equal_error_speedups(values: list[dict]) -> list[dict]:
+    """Per (heightmap, angle): adaptive POM against the cheapest POM setting (any layer count
+    measured) whose p95 UV error is at most adaptive's."""
+    adaptive = {(v["heightmap"], v["angle"]): v for v in values if v["technique"] == ADAPTIVE}
+    pom = defaultdict(list)
+    for v in values:
+        if v["technique"] == "pom":
+            pom[v["heightmap"], v["angle"]].append(v)
+    out = []
+    for key, a in sorted(adaptive.items()):
+        matching = [p for p in pom[key] if p["uv_err_p95"] <= a["uv_err_p95"]]
+        best = min(matching, key=lambda p: p["gpu_ms"]) if matching else None
+        out.append({"heightmap": key[0], "angle": key[1], "adaptive": a, "pom": best,
+                    "best_pom_p95": min((p["uv_err_p95"] for p in pom[key]), default=float("nan")),
+                    "speedup": best["gpu_ms"] / a["gpu_ms"] if best and a["gpu_ms"] > 0 else float("nan")})
+    return out
+
+
+def table41_section(values: list[dict], registry_has_adaptive: bool) -> list[str]:
+    lines = ["## The thesis' experiment (Table 4.1), redone with error", ""]
+    head = "| angle | " + " | ".join(f"POM {n}" for n in THESIS_LAYERS) + " | adaptive 4–32 |"
+    sep = "|---" * (len(THESIS_LAYERS) + 2) + "|"
+    lines += ["Published (frames per second, jMonkeyEngine/OpenGL, the thesis' hardware and scene; "
+              "no error was measured):", "", head, sep]
+    for angle in THESIS_ANGLES:
+        lines.append(f"| {angle:g}° | " + " | ".join(str(x) for x in THESIS_FPS[angle]) + " |")
+    lines.append("| speed vs POM 4, mean | " + " | ".join(
+        f"{np.mean([THESIS_FPS[a][i] / THESIS_FPS[a][0] for a in THESIS_ANGLES]):.2f}×"
+        for i in range(len(THESIS_LAYERS) + 1)) + " |")
+    lines.append("")
+    if not registry_has_adaptive:
+        lines += ["**Adaptive POM (`pom_adaptive`) is not in this build's technique registry**: the "
+                  "measured tables list POM only; the benchmark picks adaptive POM up as soon as it is "
+                  "registered.", ""]
+    table = _thesis_configs(values)
+    if not table:
+        lines += ["(This run measured none of the thesis' configurations: it needs POM with 4–32 layers "
+                  "at 0/45/60/80°.)", ""]
+        return lines
+    columns = [f"POM {n}" for n in THESIS_LAYERS] + (["adaptive"] if registry_has_adaptive else [])
+    maps = sorted({k[0] for k in table}, key=lambda m: (m not in ("brick", "bricks"), m))
+    for m in maps:
+        lines += [f"Measured on **{m}**: GPU time as a multiple of basic texturing / speed relative to "
+                  "POM 4 at the same angle / p95 UV error in texels:", "",
+                  "| angle | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
+        for angle in THESIS_ANGLES:
+            cells = table.get((m, angle))
+            if not cells:
+                continue
+            base = cells.get("POM 4")
+            row = []
+            for c in columns:
+                v = cells.get(c)
+                if v is None:
+                    row.append("–")
+                    continue
+                rel = base["gpu_ms"] / v["gpu_ms"] if base and v["gpu_ms"] > 0 else float("nan")
+                row.append(f"{_f(v['ratio_to_basic'])}× / {_f(rel)} / {_f(v['uv_err_p95'])}")
+            lines.append(f"| {angle:g}° | " + " | ".join(row) + " |")
+        lines.append("")
+        # The thesis' "efficiency" figure recomputed on our times: mean FPS-equivalent of adaptive
+        # against the mean of the POM columns with 4 and 8 layers at half weight.
+        fps = {c: [1000.0 / table[m, a][c]["gpu_ms"] for a in THESIS_ANGLES
+                   if (m, a) in table and c in table[m, a] and table[m, a][c]["gpu_ms"] > 0] for c in columns}
+        if registry_has_adaptive and all(len(fps[c]) == len(THESIS_ANGLES) for c in columns):
+            weights = [0.5, 0.5, 1, 1, 1]
+            pom_mean = sum(w * np.mean(fps[f"POM {n}"]) for w, n in zip(weights, THESIS_LAYERS)) / sum(weights)
+            lines += [f"The thesis' efficiency figure (mean FPS of adaptive vs the weighted mean of the POM "
+                      f"columns, 4 and 8 layers at half weight; thesis: 410 vs 331, +24 %) on these times: "
+                      f"{np.mean(fps['adaptive']):.0f} vs {pom_mean:.0f} frames/s-equivalent "
+                      f"({(np.mean(fps['adaptive']) / pom_mean - 1) * 100:+.0f} %). It ignores error.", ""]
+    speedups = equal_error_speedups(values)
+    if speedups:
+        lines += ["Speed-up of adaptive POM over the cheapest POM setting (any measured layer count) whose "
+                  "p95 UV error is at most adaptive POM's (> 1: adaptive is faster at equal or better error):", "",
+                  "| height map | angle | adaptive p95 (texels) | adaptive × basic | matching POM | its p95 | "
+                  "its × basic | speed-up |", "|---|---|---|---|---|---|---|---|"]
+        for s in speedups:
+            a, p = s["adaptive"], s["pom"]
+            if p is None:
+                lines.append(f"| {s['heightmap']} | {s['angle']:g}° | {_f(a['uv_err_p95'])} | "
+                             f"{_f(a['ratio_to_basic'])} | none measured (best POM p95 {_f(s['best_pom_p95'])}) "
+                             f"| – | – | – |")
+            else:
+                lines.append(f"| {s['heightmap']} | {s['angle']:g}° | {_f(a['uv_err_p95'])} | "
+                             f"{_f(a['ratio_to_basic'])} | POM {_layers(p['params'])} | {_f(p['uv_err_p95'])} | "
+                             f"{_f(p['ratio_to_basic'])} | {_f(s['speedup'])}× |")
+        finite = [s["speedup"] for s in speedups if math.isfinite(s["speedup"])]
+        if finite:
+            lines += ["", f"Geometric mean speed-up over the {len(finite)} cases with a matching POM setting: "
+                      f"{_geomean(finite):.2f}× (range {min(finite):.2f}–{max(finite):.2f}×)."]
+        lines.append("")
+    return lines
+
+
+# --- report -----------------------------------------------------------------------------------
+
+def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | None) -> str:
+    from wgpuviewer.relief.techniques import TECHNIQUES
+
+    suite = meta["suite"]
+    w, h = suite.resolution
+    lines = [
+        f"# wgpuviewer benchmark: speed against error ({suite.name} suite)", "",
+        f"- adapter: **{meta['adapter']}** (backend {meta['backend']})",
+        f"- date: {meta['date']}",
+        f"- command: `{meta['command']}`",
+        f"- frame: {w}×{h}; timer: {meta['timer']} (median of {suite.frames} frames after {suite.warmup} "
+        f"warm-up rounds, configurations interleaved frame by frame)",
+        f"- height maps: {', '.join(dict.fromkeys(v['heightmap'] for v in values)) or 'none'}; "
+        f"centre angles: {', '.join(f'{a:g}°' for a in suite.angles)}",
+        f"- techniques: {', '.join(meta['techniques'])}; {len(meta['configs'])} configurations",
+        f"- up to {suite.eval_pixels} pixels per measurement compared with the float64 reference"
+        + (f"; python {meta['python']} on {meta['platform']}" if meta.get("python") else ""),
+    ]
+    if meta["software"]:
+        lines.append("- **software adapter**: times are CPU times of an emulated GPU. Only the ratios to basic "
+                     "(measured side by side) and the fetch counts say anything, and the ratios may differ on "
+                     "real GPUs.")
+    if meta["timer"] == "timestamp" and meta["busy_max"] > 1.05:
+        lines.append(f"- **warning**: timed GPU intervals add up to {meta['busy_max']:.2f}× the wall time of "
+                     "the run: the timestamp unit may not be nanoseconds on this adapter.")
+    for note in meta["notes"]:
+        lines.append(f"- note: {note}")
+    lines += ["", "Method and definitions: docs/benchmarks.md. The angle is the view angle at the frame "
+              "centre; it varies over the frame by up to about 1.5° (CSV: angle_min, angle_max). Rows with "
+              "capped rays exclude them from the UV error; the capped fraction is listed beside it.", ""]
+
+    lines += ["## Headline: cheapest technique per error budget", "",
+              f"A configuration meets a budget when its p95 UV error is within it in every measurement up to "
+              f"{HEADLINE_MAX_ANGLE:g}° (all height maps of this run); cost is the geometric mean of its time "
+              "ratio to basic over those measurements.", "",
+              "| p95 budget (texels) | cheapest | × basic | fetches/pixel (mean) | worst p95 |", "|---|---|---|---|---|"]
+    for hl in headline(values):
+        if hl["config"] is None:
+            lines.append(f"| ≤ {hl['budget']:g} | none of the measured configurations | – | – | – |")
+        else:
+            lines.append(f"| ≤ {hl['budget']:g} | {_label(hl['config'])} | {_f(hl['ratio'])} | "
+                         f"{_f(hl['fetches'], 1)} | {_f(hl['worst_p95'])} |")
+    angles = sorted({v["angle"] for v in values})
+    pab = per_angle_budget(values)
+    lines += ["", "Per angle (p95 within the budget on every height map at that angle):", "",
+              "| budget | " + " | ".join(f"{a:g}°" for a in angles) + " |", "|---" * (len(angles) + 1) + "|"]
+    for budget in BUDGETS:
+        cells = []
+        for a in angles:
+            best = pab.get((budget, a))
+            cells.append("none" if best is None else f"{_label(best[0])} ({_f(best[1])}×)")
+        lines.append(f"| ≤ {budget:g} | " + " | ".join(cells) + " |")
+    lines.append("")
+
+    lines += table41_section(values, "pom_adaptive" in TECHNIQUES)
+
+    lines += ["## Per height map", "",
+              "Time ratio to basic and fetches: mean over the angles; then the p95 UV error (texels) per angle. "
+              "All numbers per measurement are in results.csv.", ""]
+    for m in dict.fromkeys(v["heightmap"] for v in values):
+        vs = [v for v in values if v["heightmap"] == m]
+        m_angles = sorted({v["angle"] for v in vs})
+        lines += [f"### {m} ({vs[0]['heightmap_size']})", "",
+                  "| configuration | × basic | fetches | capped | min PSNR (dB) | " +
+                  " | ".join(f"p95 {a:g}°" for a in m_angles) + " |", "|---" * (len(m_angles) + 5) + "|"]
+        by_config = defaultdict(dict)
+        for v in vs:
+            by_config[_key(v)][v["angle"]] = v
+        for key, per_angle in by_config.items():
+            rows = list(per_angle.values())
+            lines.append(
+                f"| {_label(key)} | {_f(float(np.mean([r['ratio_to_basic'] for r in rows])))} | "
+                f"{_f(float(np.mean([r['fetches_mean'] for r in rows])), 1)} | "
+                f"{float(np.mean([r['capped_fraction'] for r in rows])):.1%} | "
+                f"{_f(float(np.nanmin([r['psnr_db'] for r in rows])), 1)} | "
+                + " | ".join(_f(per_angle[a]["uv_err_p95"]) if a in per_angle else "–" for a in m_angles) + " |")
+        lines.append("")
+
+    lines += ["## Plots", ""]
+    if plot_note:
+        lines.append(plot_note)
+    for p in plots:
+        lines.append(f"![{p}]({p})")
+    lines.append("")
+    return "\n".join(lines)
+
+
+# --- plots ------------------------------------------------------------------------------------
+
+def pareto_front(points: list[tuple[float, float]]) -> list[int]:
+    """Indices of the points no other point beats in both x and y (lower is better), by x."""
+    order = sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1]))
+    front, best_y = [], math.inf
+    for i in order:
+        if points[i][1] < best_y:
+            front.append(i)
+            best_y = points[i][1]
+    return front
+
+
+def plots(out: Path, values: list[dict]) -> tuple[list[str], str | None]:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return [], "Plots skipped: matplotlib is not installed (pip install 'wgpuviewer[bench]')."
+    written = []
+    maps = list(dict.fromkeys(v["heightmap"] for v in values))
+    techniques = list(dict.fromkeys(v["technique"] for v in values))
+    colors = {t: plt.cm.tab10(i % 10) for i, t in enumerate(techniques)}
+    floor = 1e-3  # p95 of 0 drawn at this value on the log axis
+
+    cols = min(3, len(maps)) or 1
+    rows_n = max(1, math.ceil(len(maps) / cols))
+    fig, axes = plt.subplots(rows_n, cols, figsize=(4.2 * cols, 3.4 * rows_n), squeeze=False)
+    for ax, m in zip(axes.ravel(), maps):
+        by_config = defaultdict(list)
+        for v in values:
+            if v["heightmap"] == m:
+                by_config[_key(v)].append(v)
+        keys = list(by_config)
+        pts = [(float(np.mean([v["ratio_to_basic"] for v in by_config[k]])),
+                max(float(np.mean([v["uv_err_p95"] for v in by_config[k]])), floor)) for k in keys]
+        for k, (x, y) in zip(keys, pts):
+            ax.scatter(x, y, color=colors[k[0]], s=14)
+        front = pareto_front(pts)
+        ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=0.8)
+        for i in front:
+            ax.annotate(_label(keys[i]).replace("layers=", ""), pts[i], fontsize=6, xytext=(3, 3),
+                        textcoords="offset points")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(m, fontsize=9)
+        ax.set_xlabel("GPU time / basic (mean over angles)", fontsize=7)
+        ax.set_ylabel("p95 UV error, texels (mean over angles)", fontsize=7)
+        ax.tick_params(labelsize=6)
+    for ax in axes.ravel()[len(maps):]:
+        ax.axis("off")
+    handles = [plt.Line2D([], [], marker="o", ls="", color=colors[t], label=t) for t in techniques]
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(techniques), 6), fontsize=7)
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
+    _save(fig, out / "pareto.png")
+    plt.close(fig)
+    written.append("pareto.png")
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    by_config = defaultdict(lambda: defaultdict(list))
+    for v in values:
+        by_config[_key(v)][v["angle"]].append(v["fetches_mean"])
+    for k, per_angle in by_config.items():
+        angles = sorted(per_angle)
+        ax.plot(angles, [np.mean(per_angle[a]) for a in angles], marker=".", color=colors[k[0]],
+                lw=0.9, label=_label(k))
+    ax.set_yscale("symlog", linthresh=1)
+    ax.set_xlabel("view angle at the frame centre (degrees)")
+    ax.set_ylabel("depth fetches per pixel (mean over height maps)")
+    ax.legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    _save(fig, out / "fetches_vs_angle.png")
+    plt.close(fig)
+    written.append("fetches_vs_angle.png")
+    return written, None
+
+
+def _save(fig, path: Path) -> None:
+    from wgpuviewer.core.io import write_bytes
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=72)
+    write_bytes(path, buf.getvalue())
+
+
+def write_outputs(out: Path, rows, meta: dict) -> None:
+    values = [r.values for r in rows]
+    written, note = plots(Path(out), values) if values else ([], "No rows: no plots.")
+    text = report(values, meta, written, note)
+    from wgpuviewer.core.io import write_bytes
+
+    write_bytes(Path(out) / "report.md", text.encode("utf-8"))

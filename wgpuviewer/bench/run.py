@@ -1,0 +1,329 @@
+"""``wgpuviewer bench``: speed against error of every registered technique, with a float64 reference.
+
+For each height map x technique x parameter setting x view angle it measures, on a full-screen
+view of the relief (bench/view.py):
+
+- GPU time per frame (timestamp queries, median over ``frames`` frames after warm-up), with
+  ``basic`` texturing timed side by side in the same run: ``ratio_to_basic`` = time / basic time;
+- cost: depth fetches per pixel (mean, p95) from the techniques' own counters (the data target),
+  and the fraction of rays that hit a cap;
+- error against the float64 reference (reference.exact_hit): UV error in texels (mean, p95, max)
+  over a regular subsample of pixels, and the PSNR of the image shaded on the CPU at the
+  technique's hit UVs against the same shading at the reference hit UVs.
+
+Techniques come from the registry (``techniques.TECHNIQUES``); ``SWEEPS`` lists the parameter
+settings tried per technique name, and a technique it does not name runs with its registry
+defaults, so new techniques are benchmarked without changes here.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime
+import io
+import platform
+import sys
+import tempfile
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.io import write_bytes
+from wgpuviewer.relief.techniques import TECHNIQUES, resolve_params
+
+#: Parameter settings per technique name (overrides of the registry defaults). Settings naming a
+#: parameter the technique does not have are skipped; a technique not listed runs its defaults.
+SWEEPS: dict[str, tuple[dict, ...]] = {
+    "parallax": ({}, {"offset_limiting": True}),
+    "steep": ({"layers": 8}, {"layers": 16}, {"layers": 32}, {"layers": 64}),
+    "pom": tuple({"layers": n} for n in (4, 8, 16, 24, 32, 64, 128)),
+    "pom_adaptive": ({},),
+}
+
+#: The smoke suite's smaller sweeps (still all of Table 4.1's POM layer counts).
+SMOKE_SWEEPS: dict[str, tuple[dict, ...]] = {
+    "parallax": ({},),
+    "steep": ({"layers": 16},),
+    "pom": tuple({"layers": n} for n in (4, 8, 16, 24, 32, 64)),
+    "pom_adaptive": ({},),
+}
+
+BASELINE = "basic"
+REAL_MAPS = ("brick", "grass", "gravel")  # scikit-image's bundled textures (optional)
+SYNTHETIC_MAPS = ("bricks", "bumps", "ridges", "flat0", "flat1", "spike", "step", "wall", "checker")
+ALL_ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 89.0)
+
+
+@dataclass(frozen=True)
+class Suite:
+    name: str
+    heightmaps: tuple[str, ...]
+    angles: tuple[float, ...]
+    resolution: tuple[int, int]
+    frames: int
+    warmup: int
+    sweeps: dict = field(default_factory=dict)
+    eval_pixels: int = 65536  # pixels per measurement compared with the reference
+    builtin_size: int = 256
+
+
+SUITES = {
+    "smoke": Suite("smoke", ("brick", "bricks", "spike"), (0.0, 45.0, 60.0, 80.0, 89.0), (96, 54), 30, 3,
+                   SMOKE_SWEEPS, eval_pixels=1500, builtin_size=128),
+    "full": Suite("full", REAL_MAPS + SYNTHETIC_MAPS, ALL_ANGLES, (1920, 1080), 50, 5, SWEEPS,
+                  eval_pixels=32768, builtin_size=256),
+}
+
+COLUMNS = (
+    "suite", "heightmap", "heightmap_size", "technique", "params", "angle", "angle_min", "angle_max",
+    "resolution", "adapter", "backend", "timer", "frames", "gpu_ms", "basic_ms", "ratio_to_basic",
+    "fetches_mean", "fetches_p95", "uv_err_mean", "uv_err_p95", "uv_err_max", "psnr_db",
+    "capped_fraction", "covered_fraction", "eval_pixels",
+)
+
+
+def params_label(params: dict) -> str:
+    if not params:
+        return "-"
+    return " ".join(f"{k}={str(v).lower() if isinstance(v, bool) else v}" for k, v in params.items())
+
+
+def settings_for(name: str, sweeps: dict) -> list[dict]:
+    """Full parameter dicts (registry defaults + overrides) to benchmark for technique ``name``."""
+    technique = TECHNIQUES[name]
+    known = {p.name for p in technique.params}
+    out: list[dict] = []
+    for overrides in sweeps.get(name, ({},)):
+        if not set(overrides) <= known:
+            continue  # the registry entry changed; this setting no longer applies
+        values = resolve_params(technique, overrides)
+        if values not in out:
+            out.append(values)
+    return out or [technique.defaults()]
+
+
+def configs_for(techniques: list[str], sweeps: dict) -> list[tuple[str, dict]]:
+    configs = [(BASELINE, TECHNIQUES[BASELINE].defaults())]
+    for name in techniques:
+        for values in settings_for(name, sweeps):
+            if (name, values) not in configs:
+                configs.append((name, values))
+    return configs
+
+
+def skimage_available() -> bool:
+    try:
+        import skimage.data  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+@dataclass
+class Options:
+    suite: Suite
+    techniques: list[str]
+    backend: str | None
+    command: str
+    notes: list[str] = field(default_factory=list)
+
+
+def resolve_options(suite_name: str, resolution=None, heightmaps=None, techniques=None, angles=None,
+                    frames=None, backend=None, command="") -> Options:
+    """Validated run options (UserError naming the option on bad input)."""
+    from wgpuviewer.textures import BUILTINS
+
+    if suite_name not in SUITES:
+        raise UserError(f"--suite {suite_name!r}: unknown; expected one of {', '.join(SUITES)}")
+    suite = SUITES[suite_name]
+    notes = []
+    if resolution is not None:
+        suite = replace(suite, resolution=tuple(resolution))
+    if frames is not None:
+        if frames < 1:
+            raise UserError(f"--frames {frames}: expected at least 1 (30 or more for a stable median)")
+        suite = replace(suite, frames=frames)
+    if angles is not None:
+        for a in angles:
+            if not 0.0 <= a <= 89.0:
+                raise UserError(f"--angles: {a:g} out of range; expected 0 to 89 degrees "
+                                f"(the frame spans about 1.5 degrees, and must not look past the horizon)")
+        suite = replace(suite, angles=tuple(float(a) for a in angles))
+    known_maps = tuple(BUILTINS) + REAL_MAPS
+    if heightmaps is not None:
+        for name in heightmaps:
+            if name not in known_maps:
+                raise UserError(f"--heightmaps: unknown height map {name!r}; expected some of {', '.join(known_maps)}")
+            if name in REAL_MAPS and not skimage_available():
+                raise UserError(f"--heightmaps: {name!r} needs scikit-image; install it with "
+                                f"pip install 'wgpuviewer[bench]'")
+        suite = replace(suite, heightmaps=tuple(heightmaps))
+    elif not skimage_available():
+        kept = tuple(h for h in suite.heightmaps if h not in REAL_MAPS)
+        if kept != suite.heightmaps:
+            notes.append("scikit-image is not installed: its real textures (brick, grass, gravel) were "
+                         "left out (pip install 'wgpuviewer[bench]')")
+            suite = replace(suite, heightmaps=kept or ("bricks",))
+    if techniques is not None:
+        for name in techniques:
+            if name not in TECHNIQUES:
+                raise UserError(f"--techniques: unknown technique {name!r}; expected some of {', '.join(TECHNIQUES)}")
+        chosen = [t for t in TECHNIQUES if t in techniques]
+    else:
+        chosen = list(TECHNIQUES)
+    if frames is not None and frames < 30:
+        notes.append(f"--frames {frames}: fewer than 30 timed frames per configuration; medians are noisy")
+    return Options(suite, chosen, backend, command, notes)
+
+
+@dataclass
+class Row:
+    values: dict
+    errors: np.ndarray  # per-pixel UV errors (texels), kept for pooled statistics
+
+
+def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
+    """Run the benchmark; write ``out``/results.csv, report.md and plots. Returns the CSV rows."""
+    from tqdm import tqdm
+
+    from wgpuviewer.core.gpu import get_gpu
+    from wgpuviewer.relief.renderer import DrawConfig, Renderer
+
+    from .report import write_outputs
+    from .timing import time_configs
+    from .view import Shader, errors, load_heightmap, make_view, reference
+
+    suite = options.suite
+    gpu = get_gpu(options.backend, quiet=True)
+    adapter = gpu.summary
+    backend = gpu.adapter.info.get("backend_type", "")
+    configs = configs_for(options.techniques, suite.sweeps)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    size = suite.resolution
+    rows: list[Row] = []
+    busy = []
+    started = datetime.datetime.now(datetime.UTC)
+    total = len(suite.heightmaps) * len(suite.angles) * len(configs)
+    with tempfile.TemporaryDirectory(prefix="wgpuviewer-bench-") as workdir, \
+            tqdm(total=total, desc="bench", unit="row", file=sys.stderr, disable=not progress) as bar:
+        for map_name in suite.heightmaps:
+            try:
+                heightmap = load_heightmap(map_name, suite.builtin_size, Path(workdir))
+            except Exception as e:  # noqa: BLE001 - e.g. scikit-image's data not loadable offline
+                options.notes.append(f"height map {map_name!r} left out: {type(e).__name__}: {e}")
+                bar.update(len(suite.angles) * len(configs))
+                continue
+            for angle in suite.angles:
+                bar.set_postfix_str(f"{map_name} {angle:g}°")
+                try:
+                    view = make_view(heightmap, angle, size)
+                except ValueError as e:
+                    raise UserError(f"--angles {angle:g}: {e}") from None
+                renderer = Renderer(view.scene, gpu)
+                timing = time_configs(renderer, configs, size, suite.frames, suite.warmup)
+                busy.append(timing.busy_fraction)
+                ref = reference(view, suite.eval_pixels)
+                shader = Shader(view)
+                basic_ms = timing.results[0].median_ms
+                for (name, params), t in zip(configs, timing.results):
+                    image = renderer.render(DrawConfig.of(name, params), size)
+                    covered = image.covered
+                    raw = image.data[:, :, 3][covered]
+                    capped = raw < 0
+                    fetches = np.where(capped, -raw - 1.0, raw).astype(np.float64)
+                    err = errors(view, ref, image.data, covered, shader)
+                    e = err.uv_texels
+                    rows.append(Row({
+                        "suite": suite.name, "heightmap": map_name,
+                        "heightmap_size": f"{heightmap.size[0]}x{heightmap.size[1]}",
+                        "technique": name, "params": params_label(params), "angle": angle,
+                        "angle_min": round(view.angle_min, 3), "angle_max": round(view.angle_max, 3),
+                        "resolution": f"{size[0]}x{size[1]}", "adapter": adapter, "backend": backend,
+                        "timer": timing.timer, "frames": suite.frames,
+                        "gpu_ms": t.median_ms, "basic_ms": basic_ms,
+                        "ratio_to_basic": t.median_ms / basic_ms if basic_ms > 0 else float("nan"),
+                        "fetches_mean": float(fetches.mean()) if fetches.size else float("nan"),
+                        "fetches_p95": float(np.percentile(fetches, 95)) if fetches.size else float("nan"),
+                        "uv_err_mean": float(e.mean()) if e.size else float("nan"),
+                        "uv_err_p95": float(np.percentile(e, 95)) if e.size else float("nan"),
+                        "uv_err_max": float(e.max()) if e.size else float("nan"),
+                        "psnr_db": err.psnr,
+                        "capped_fraction": float(capped.mean()) if capped.size else float("nan"),
+                        "covered_fraction": float(covered.mean()),
+                        "eval_pixels": err.pixels,
+                    }, e))
+                    bar.update()
+                write_csv(out / "results.csv", [r.values for r in rows])  # partial results survive a kill
+    finished = datetime.datetime.now(datetime.UTC)
+    meta = {
+        "suite": suite, "adapter": adapter, "backend": backend, "software": gpu.software,
+        "timer": rows[0].values["timer"] if rows else "", "command": options.command,
+        "date": f"{started:%Y-%m-%d %H:%M} UTC (took {(finished - started).total_seconds():.0f} s)",
+        "notes": options.notes, "configs": configs,
+        "techniques": options.techniques, "busy_max": max(busy) if busy else float("nan"),
+        "python": platform.python_version(), "platform": platform.platform(),
+    }
+    write_csv(out / "results.csv", [r.values for r in rows])
+    write_outputs(out, rows, meta)
+    return [r.values for r in rows]
+
+
+def _fmt_csv(value):
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return value
+
+
+def write_csv(path: Path, rows: list[dict]) -> None:
+    text = io.StringIO(newline="")
+    writer = csv.DictWriter(text, fieldnames=COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: _fmt_csv(row[k]) for k in COLUMNS})
+    write_bytes(path, text.getvalue().encode("utf-8"))
+
+
+def read_csv(path: Path) -> list[dict]:
+    """results.csv back as dicts with numbers parsed (for tests and re-reporting)."""
+    numeric = set(COLUMNS) - {"suite", "heightmap", "heightmap_size", "technique", "params", "resolution",
+                              "adapter", "backend", "timer"}
+    with open(path, newline="", encoding="utf-8") as f:
+        return [{k: (float(v) if k in numeric else v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+
+def rereport(csv_paths: list[Path], out: Path, command: str = "") -> list[dict]:
+    """report.md and plots again from one or more results.csv files (e.g. parts of one run)."""
+    from .report import write_outputs
+
+    values = []
+    for path in csv_paths:
+        try:
+            values += read_csv(Path(path))
+        except (OSError, KeyError, ValueError) as e:
+            raise UserError(f"--from-csv {path}: cannot read benchmark results ({e})") from None
+    if not values:
+        raise UserError("--from-csv: no rows in " + ", ".join(map(str, csv_paths)))
+    first = values[0]
+    w, h = (int(x) for x in first["resolution"].split("x"))
+    base = SUITES.get(first["suite"], SUITES["full"])
+    suite = replace(base, resolution=(w, h), frames=int(first["frames"]),
+                    heightmaps=tuple(dict.fromkeys(v["heightmap"] for v in values)),
+                    angles=tuple(sorted({v["angle"] for v in values})))
+    configs = list(dict.fromkeys((v["technique"], v["params"]) for v in values))
+    adapters = sorted({v["adapter"] for v in values})
+    meta = {
+        "suite": suite, "adapter": " / ".join(adapters), "backend": first["backend"],
+        "software": "(CPU)" in first["adapter"] or "llvmpipe" in first["adapter"], "timer": first["timer"],
+        "command": command, "date": "see the results' source; regenerated from " + ", ".join(Path(p).name for p in csv_paths),
+        "notes": [] if len(adapters) == 1 else ["rows from several adapters: compare ratios per adapter only"],
+        "configs": configs, "techniques": list(dict.fromkeys(v["technique"] for v in values)),
+        "busy_max": float("nan"), "python": platform.python_version(), "platform": platform.platform(),
+    }
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_csv(out / "results.csv", values)
+    write_outputs(out, [Row(v, np.empty(0)) for v in values], meta)
+    return values

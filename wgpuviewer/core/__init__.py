@@ -1,0 +1,7 @@
+"""The foundation every other room stands on: errors, GPU acquisition and texture upload, atomic file writes,
+the one image and height-file reader, CPU texture sampling (nearest/bilinear, repeat/clamp), colour transfer
+functions and the heat ramp, and the one WGSL composer.
+
+May import: the standard library and third-party packages only, never another part of this project
+(``maptools`` relies on that: it imports ``wgpuviewer.core`` and nothing else of ``wgpuviewer``).
+"""

@@ -1,0 +1,19 @@
+"""Errors. ``UserError``: bad input a user can fix (file, TOML, name, value, a missing system piece); the CLIs
+print it as one line on stderr and exit with code 2. ``InputError``: a library function called with arguments
+it cannot use (shape, range, NaN); a ``ValueError``, which the CLIs also report as one line, exit code 2."""
+
+
+class UserError(Exception):
+    """Bad input (file, TOML, name, value) or a missing system piece, with the fix in the message."""
+
+    exit_code = 2
+
+
+class NoAdapterError(UserError):
+    """No wgpu adapter for the requested backend."""
+
+
+class InputError(ValueError):
+    """A library function got arguments it cannot use; the message names the argument and what is expected."""
+
+    exit_code = 2

@@ -1,0 +1,187 @@
+"""GPU acquisition: pick an adapter for a backend, create (and cache) one device per backend.
+
+`auto` prefers a hardware adapter (discrete, then integrated) and falls back to a software one
+(Mesa lavapipe/llvmpipe, WARP, SwiftShader) with a one-line notice on stderr.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+import wgpu
+
+from .errors import NoAdapterError, UserError
+
+#: CLI name -> wgpu backend_type as reported in ``adapter.info``.
+BACKENDS = {"vulkan": "Vulkan", "metal": "Metal", "dx12": "D3D12", "gl": "OpenGL"}
+BACKEND_CHOICES = ("auto", *BACKENDS)
+BACKEND_ENV = "WGPUVIEWER_BACKEND"
+
+#: Optional features we use when the adapter has them.
+WANTED_FEATURES = ("float32-filterable", "timestamp-query", "shader-f64")
+
+_TYPE_RANK = {"DiscreteGPU": 0, "IntegratedGPU": 1, "VirtualGPU": 2, "Unknown": 3, "CPU": 4}
+
+NO_ADAPTER_FIX = (
+    "install a GPU driver with Vulkan/Metal/D3D12/OpenGL support, or the software Vulkan adapter "
+    "(Debian/Ubuntu: sudo apt-get install mesa-vulkan-drivers)"
+)
+
+
+def resolve_backend(backend: str | None) -> str:
+    """CLI/env backend name -> one of BACKEND_CHOICES (argument wins over the environment)."""
+    name = (backend or os.environ.get(BACKEND_ENV) or "auto").strip().lower()
+    if name not in BACKEND_CHOICES:
+        source = "--backend" if backend else BACKEND_ENV
+        raise UserError(f"{source}: unknown backend {name!r}; expected one of {', '.join(BACKEND_CHOICES)}")
+    return name
+
+
+def list_adapters() -> list[wgpu.GPUAdapter]:
+    return list(wgpu.gpu.enumerate_adapters_sync())
+
+
+def is_software(adapter: wgpu.GPUAdapter) -> bool:
+    return adapter.info.get("adapter_type") == "CPU"
+
+
+def choose_adapter(backend: str | None = None, *, quiet: bool = False) -> wgpu.GPUAdapter:
+    """The adapter for a backend name; raises NoAdapterError with the fix when there is none."""
+    name = resolve_backend(backend)
+    adapters = list_adapters()
+    if name != "auto":
+        adapters = [a for a in adapters if a.info.get("backend_type") == BACKENDS[name]]
+    if not adapters:
+        where = "" if name == "auto" else f" for backend {name!r}"
+        raise NoAdapterError(f"no GPU adapter found{where}; {NO_ADAPTER_FIX}")
+    # Stable choice: best adapter type first; Vulkan/Metal/D3D12 before OpenGL (better feature coverage).
+    adapters.sort(key=lambda a: (_TYPE_RANK.get(a.info.get("adapter_type"), 3), a.info.get("backend_type") == "OpenGL"))
+    chosen = adapters[0]
+    if is_software(chosen) and not quiet:
+        print(f"notice: no hardware GPU adapter; using software adapter {chosen.summary}", file=sys.stderr)
+    return chosen
+
+
+@dataclass
+class Gpu:
+    """A device and what we know about it; shared by the renderer, the probe and maptools."""
+
+    adapter: wgpu.GPUAdapter
+    device: wgpu.GPUDevice
+    features: frozenset[str] = field(default_factory=frozenset)
+    #: Per-device caches (pipelines, layouts), keyed by their users.
+    cache: dict = field(default_factory=dict)
+
+    @property
+    def summary(self) -> str:
+        return self.adapter.summary
+
+    @property
+    def software(self) -> bool:
+        return is_software(self.adapter)
+
+    @property
+    def depth_format(self) -> str:
+        """Filterable format for height/depth data: float32 where the adapter can filter it."""
+        return "r32float" if "float32-filterable" in self.features else "r16float"
+
+
+_devices: dict[str, Gpu] = {}
+
+
+def get_gpu(backend: str | None = None, *, quiet: bool = False) -> Gpu:
+    """One cached device per backend name (creating devices is slow, and resources must share one)."""
+    name = resolve_backend(backend)
+    if name not in _devices:
+        adapter = choose_adapter(name, quiet=quiet)
+        features = frozenset(f for f in WANTED_FEATURES if f in adapter.features)
+        device = adapter.request_device_sync(label="wgpuviewer", required_features=sorted(features))
+        _devices[name] = Gpu(adapter, device, features)
+    return _devices[name]
+
+
+def describe_adapters(backend: str | None = None) -> str:
+    """Text for `wgpuviewer info`."""
+    lines = ["adapters:"]
+    adapters = list_adapters()
+    for a in adapters:
+        info = a.info
+        lines.append(f"  - {a.summary}  [type {info.get('adapter_type')}, backend {info.get('backend_type')}]")
+    if not adapters:
+        lines.append(f"  (none) -- {NO_ADAPTER_FIX}")
+        return "\n".join(lines)
+    chosen = choose_adapter(backend, quiet=True)
+    lines.append(f"chosen ({resolve_backend(backend)}): {chosen.summary}")
+    have = sorted(f for f in WANTED_FEATURES if f in chosen.features)
+    missing = sorted(set(WANTED_FEATURES) - set(have))
+    lines.append(f"relevant features: {', '.join(have) or 'none'}" + (f"; missing: {', '.join(missing)}" if missing else ""))
+    limits = chosen.limits
+    shown = ("max-texture-dimension-2d", "max-texture-dimension-3d", "max-storage-buffer-binding-size")
+    lines.append("limits: " + ", ".join(f"{k}={limits[k]}" for k in shown))
+    return "\n".join(lines)
+
+
+# --- resource helpers shared by the renderer, the probe and the viewer ------------------------
+
+_TEXEL = {  # format -> (numpy dtype, channels)
+    "r32float": (np.float32, 1),
+    "r16float": (np.float16, 1),
+    "rgba16float": (np.float16, 4),
+    "rgba8unorm": (np.uint8, 4),
+    "rgba8unorm-srgb": (np.uint8, 4),
+}
+
+
+def to_texel_data(data: np.ndarray, fmt: str) -> np.ndarray:
+    """(H, W) or (H, W, C) floats in [0, 1] -> contiguous texel array for ``fmt``."""
+    dtype, channels = _TEXEL[fmt]
+    a = np.asarray(data, dtype=np.float32)
+    if a.ndim == 2:
+        a = a[:, :, None]
+    if a.shape[2] < channels:  # pad missing channels with 1 (alpha)
+        a = np.concatenate([a, np.ones(a.shape[:2] + (channels - a.shape[2],), np.float32)], axis=2)
+    a = a[:, :, :channels]
+    if dtype == np.uint8:
+        a = np.clip(np.rint(a * 255.0), 0, 255)
+    return np.ascontiguousarray(a.astype(dtype))
+
+
+def create_texture(gpu: Gpu, levels: list[np.ndarray], fmt: str, label: str) -> wgpu.GPUTexture:
+    """A sampled 2D texture from a mip chain (``levels[0]`` is the base level)."""
+    base = levels[0]
+    h, w = base.shape[:2]
+    limit = gpu.adapter.limits["max-texture-dimension-2d"]
+    if max(w, h) > limit:
+        raise UserError(f"{label}: texture of {w}x{h} exceeds this adapter's limit of {limit} texels per side")
+    texture = gpu.device.create_texture(
+        label=label,
+        size=(w, h, 1),
+        format=fmt,
+        usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
+        mip_level_count=len(levels),
+    )
+    for level, data in enumerate(levels):
+        texels = to_texel_data(data, fmt)
+        lh, lw = texels.shape[:2]
+        gpu.device.queue.write_texture(
+            {"texture": texture, "mip_level": level, "origin": (0, 0, 0)},
+            texels,
+            {"offset": 0, "bytes_per_row": texels.strides[0], "rows_per_image": lh},
+            (lw, lh, 1),
+        )
+    return texture
+
+
+def mip_chain(data: np.ndarray) -> list[np.ndarray]:
+    """Average (box-filtered) mip chain down to 1x1; odd sizes round down as WebGPU mips do."""
+    levels = [np.asarray(data, np.float32)]
+    while max(levels[-1].shape[:2]) > 1:
+        h, w = levels[-1].shape[:2]
+        levels.append(cv2.resize(levels[-1], (max(w // 2, 1), max(h // 2, 1)), interpolation=cv2.INTER_AREA))
+        if levels[-1].ndim < levels[0].ndim:  # cv2 drops a trailing channel axis of size 1
+            levels[-1] = levels[-1][..., None]
+    return levels

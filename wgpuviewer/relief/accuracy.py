@@ -1,0 +1,94 @@
+"""Probe-against-reference measurements: UV error in texels, fetches per ray, capped fraction.
+
+Used by the tests, ``wgpuviewer accuracy`` and (later) the benchmark, so every number about a
+technique's error is computed one way.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .probe import probe
+from .reference import exact_hit, uv_error_texels, view_dir_from_angles
+
+
+@dataclass
+class Accuracy:
+    technique: str
+    angle: float
+    params: dict
+    error_mean: float  # texels, over rays that were not capped
+    error_p95: float
+    error_max: float
+    fetches_mean: float
+    fetches_p95: float
+    capped: float  # fraction of rays flagged capped
+    rays: int
+
+
+def random_rays(n: int, angle_deg: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` entry points uniform over the texture, view directions at ``angle_deg`` from the normal
+    with uniformly random azimuth."""
+    rng = np.random.default_rng(seed)
+    uv = rng.random((n, 2))
+    view = view_dir_from_angles(np.full(n, angle_deg), rng.random(n) * 360.0)
+    return uv, view
+
+
+def measure(
+    technique: str, height: np.ndarray, angle_deg: float, height_scale: float = 0.05,
+    rays: int = 4096, seed: int = 0, backend: str | None = None, **params,
+) -> Accuracy:
+    """Trace ``rays`` random rays at ``angle_deg`` with the GPU probe and the float64 reference."""
+    height = np.asarray(height, np.float64)
+    uv, view = random_rays(rays, angle_deg, seed)
+    got = probe(technique, height, uv, view, height_scale, backend=backend, **params)
+    ref = exact_hit(1.0 - height, uv, view, height_scale)
+    ok = ~got.capped & ref.valid
+    err = uv_error_texels(got.uv[ok], ref.uv[ok], height.shape[::-1]) if ok.any() else np.array([np.nan])
+    fetches = got.fetches.astype(np.float64)
+    return Accuracy(
+        technique=technique, angle=angle_deg, params=params,
+        error_mean=float(np.mean(err)), error_p95=float(np.percentile(err, 95)), error_max=float(np.max(err)),
+        fetches_mean=float(fetches.mean()), fetches_p95=float(np.percentile(fetches, 95)),
+        capped=float(got.capped.mean()), rays=rays,
+    )
+
+
+DEFAULT_ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 89.0, 89.9)
+DEFAULT_SETTINGS = (
+    ("parallax", {}), ("parallax", {"offset_limiting": True}),
+    ("steep", {"layers": 32}), ("pom", {"layers": 8}), ("pom", {"layers": 32}), ("pom", {"layers": 256}),
+    ("pom_adaptive", {}), ("pom_adaptive", {"angle_only": True}),
+    ("relief", {}), ("relief", {"linear_steps": 32, "binary_steps": 8}),
+    ("maxmip", {}), ("distance", {}), ("distance_refined", {}), ("cone", {}),
+)
+
+
+def npot_height(shape=(401, 343)) -> np.ndarray:
+    """A smooth non-square, non-power-of-two test relief (rows, cols) = (401, 343) by default."""
+    rows, cols = shape
+    return np.clip(0.5 + 0.2 * np.sin(np.arange(rows)[:, None] / 9.0) * np.cos(np.arange(cols)[None, :] / 7.0), 0, 1)
+
+
+def table(heightmaps: dict, angles=DEFAULT_ANGLES, settings=DEFAULT_SETTINGS, height_scale=0.05, rays=4096,
+          backend=None, progress=None) -> str:
+    """Markdown table of probe-vs-reference accuracy for each height map x setting x angle."""
+    lines = [
+        "| height map | technique | params | angle | UV err mean | p95 | max (texels) | fetches mean | p95 | capped |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for name, height in heightmaps.items():
+        for technique, params in settings:
+            for angle in angles:
+                a = measure(technique, height, angle, height_scale, rays, backend=backend, **params)
+                label = ", ".join(f"{k}={v}" for k, v in params.items()) or "-"
+                lines.append(
+                    f"| {name} | {technique} | {label} | {angle:g}° | {a.error_mean:.3f} | {a.error_p95:.3f} | "
+                    f"{a.error_max:.2f} | {a.fetches_mean:.1f} | {a.fetches_p95:.0f} | {a.capped:.1%} |"
+                )
+                if progress:
+                    progress()
+    return "\n".join(lines)

@@ -1,0 +1,173 @@
+"""The texture slots a technique may sample, shared by the renderer and the probe.
+
+A technique names what it samples in ``Technique.textures``; each name is a slot here: the material's own
+textures (``albedo``, ``normal``; the renderer loads them from the scene) and the height-derived ones (``depth``
+and the maps maptools generates), which this module builds from a depth map. A slot knows its WGSL variable and
+type (``shaders.interface`` generates the binding line: binding 2 + the slot's position in ``MAP_SLOTS``) and its
+bind-group layout entry. Derived maps come from maptools' registry and disk cache (content hash + options),
+never from a private copy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import wgpu
+
+from maptools.cache import cached_generate
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
+
+from .techniques import REFINED_MAX_ANGLE
+
+
+@dataclass(frozen=True)
+class MapSlot:
+    name: str
+    wgsl_type: str  # e.g. "texture_2d<f32>"
+    layout: dict  # bind-group layout entry without binding/visibility
+    #: Height-derived slots: (gpu, depth, height_scale, label) -> texture. None: a material texture (albedo, normal).
+    build: Callable[[Gpu, np.ndarray, float, str], wgpu.GPUTexture] | None
+    doc: str  # the generated binding line's comment
+    #: Built for the material's height_scale: a tracer given another scale could step through the surface.
+    scale_bound: bool = False
+    #: WGSL variable (default NAME_tex); slots that are alternatives for one tracer may share it.
+    variable: str = ""
+
+    @property
+    def wgsl_name(self) -> str:
+        return self.variable or f"{self.name}_tex"
+
+    @property
+    def derived(self) -> bool:
+        return self.build is not None
+
+
+def _depth(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    return create_texture(gpu, mip_chain(depth), gpu.depth_format, label)
+
+
+def _complexity(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    # Relief textures tile, so the Sobel and the dilation wrap around the borders.
+    levels = cached_generate("complexity", 1.0 - depth, backend="auto", border="repeat")
+    # 8-bit levels k/255 as a filterable float texture (r8unorm has no upload path in gpu.to_texel_data).
+    return create_texture(gpu, [levels.astype(np.float32) / 255.0], gpu.depth_format, label)
+
+
+def cell_max_height(depth: np.ndarray) -> np.ndarray:
+    """Height bound of each bilinear cell: max of the cell's four corner texels (wrap), float32 (H, W).
+
+    Cell (i, j) lies between the texel centres i, i+1 and j, j+1 (texel coordinates x = u*W - 0.5); the bilinear
+    patch over it never rises above its highest corner, so a max pyramid over these values bounds the sampled
+    surface (a pyramid over the texels alone does not: a patch reaches into the neighbouring texel's cell).
+    """
+    h = 1.0 - np.asarray(depth, np.float64)
+    right = np.roll(h, -1, axis=1)
+    cell = np.maximum(np.maximum(h, right), np.maximum(np.roll(h, -1, axis=0), np.roll(right, -1, axis=0)))
+    return np.clip(cell, 0.0, 1.0).astype(np.float32)
+
+
+def maxmip_atlas(levels: list[np.ndarray]) -> np.ndarray:
+    """maptools' maxmip levels (ceil-halving) stacked into one (sum of heights, W) float32 image: level m at
+    rows [sum of earlier heights, + h_m), columns [0, w_m). maxmip.wgsl computes the same row offsets."""
+    width = levels[0].shape[1]
+    atlas = np.zeros((sum(level.shape[0] for level in levels), width), np.float32)
+    row = 0
+    for level in levels:
+        atlas[row:row + level.shape[0], :level.shape[1]] = level
+        row += level.shape[0]
+    return atlas
+
+
+def _maxmip(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    levels = cached_generate("maxmip", cell_max_height(depth), backend="auto")
+    return create_texture(gpu, [maxmip_atlas(levels)], "r32float", label)
+
+
+def _volume_texture(gpu: Gpu, volume: np.ndarray, label: str) -> wgpu.GPUTexture:
+    dz, h, w = volume.shape
+    limit = gpu.adapter.limits["max-texture-dimension-3d"]
+    if max(w, h, dz) > limit:
+        raise UserError(f"{label}: volume of {w}x{h}x{dz} exceeds this adapter's 3D limit of {limit} texels per side")
+    data = np.ascontiguousarray(volume, np.float32)
+    texture = gpu.device.create_texture(
+        label=label, size=(w, h, dz), dimension="3d", format="r32float",
+        usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
+    )
+    gpu.device.queue.write_texture(
+        {"texture": texture, "mip_level": 0, "origin": (0, 0, 0)}, data,
+        {"offset": 0, "bytes_per_row": w * 4, "rows_per_image": h}, (w, h, dz),
+    )
+    return texture
+
+
+def _distance(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    volume = cached_generate("distance", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
+                             height_scale=height_scale)
+    return _volume_texture(gpu, volume, label)
+
+
+def _distance_refined(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    volume = cached_generate("distance_refined", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
+                             height_scale=height_scale, max_angle=REFINED_MAX_ANGLE)
+    return _volume_texture(gpu, volume, label)
+
+
+def _cone(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    # The ratios do not depend on height_scale (texels of u per unit t); cone.wgsl reads them with
+    # textureLoad (nearest texel), the lookup a filter="nearest" map is built for.
+    ratios = cached_generate("cone", 1.0 - depth, backend="auto", max_ratio=CONE_MAX_RATIO, filter=CONE_FILTER)
+    return create_texture(gpu, [np.asarray(ratios, np.float32)], "r32float", label)
+
+
+#: Relaxed cone map options: the widest stored cone (texels of u per unit t; the build costs O(max_ratio^2)
+#: per texel) and the lookup cone.wgsl uses.
+CONE_MAX_RATIO = 32.0
+CONE_FILTER = "nearest"
+
+#: Depth slices of the distance volumes (maptools' default).
+DISTANCE_SLICES = 16
+
+_FILTERABLE_2D = {"texture": {"sample_type": "float", "view_dimension": "2d"}}
+_UNFILTERABLE_2D = {"texture": {"sample_type": "unfilterable-float", "view_dimension": "2d"}}
+_VOLUME = {"texture": {"sample_type": "unfilterable-float", "view_dimension": "3d"}}
+_2D, _3D = "texture_2d<f32>", "texture_3d<f32>"
+
+MAP_SLOTS: dict[str, MapSlot] = {
+    slot.name: slot
+    for slot in (
+        MapSlot("albedo", _2D, _FILTERABLE_2D, None, "linear RGB albedo (rgba16float), mip chain"),
+        MapSlot("normal", _2D, _FILTERABLE_2D, None, "tangent-space normals as n * 0.5 + 0.5 (rgba8unorm)"),
+        MapSlot("depth", _2D, _FILTERABLE_2D, _depth, "D = 1 - height, mip chain (r32float, or r16float)"),
+        MapSlot("complexity", _2D, _FILTERABLE_2D, _complexity, "the thesis' complexity map, levels k/255"),
+        MapSlot("maxmip", _2D, _UNFILTERABLE_2D, _maxmip,
+                "max pyramid atlas (r32float): level m at rows [row_m, row_m + h_m), textureLoad"),
+        # distance.wgsl reads whichever of the two distance volumes its technique needs, as distance_tex.
+        MapSlot("distance", _3D, _VOLUME, _distance, "distance volume (W, H, slices), r32float, textureLoad",
+                scale_bound=True),
+        MapSlot("distance_refined", _3D, _VOLUME, _distance_refined,
+                "visibility-refined distance volume, same layout", scale_bound=True, variable="distance_tex"),
+        MapSlot("cone", _2D, _UNFILTERABLE_2D, _cone,
+                "relaxed cone ratios (r32float), texels of u per unit t, textureLoad"),
+    )
+}
+
+#: @group(1) bindings: the TraceParams uniform, the material sampler, then the texture slots.
+PARAMS_BINDING, SAMPLER_BINDING, FIRST_SLOT_BINDING = 0, 1, 2
+
+
+def binding(name: str) -> int:
+    """@group(1) @binding(N) of a texture slot."""
+    return FIRST_SLOT_BINDING + list(MAP_SLOTS).index(name)
+
+
+def layout_entries(names, visibility) -> list[dict]:
+    """Bind-group layout entries for the texture slots ``names``."""
+    return [{"binding": binding(n), "visibility": visibility, **MAP_SLOTS[n].layout} for n in names]
+
+
+def height_scale_adjustable(textures) -> bool:
+    """Whether a technique sampling ``textures`` may trace at another height scale than its maps were built for."""
+    return not any(MAP_SLOTS[t].scale_bound for t in textures)

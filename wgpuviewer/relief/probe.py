@@ -1,0 +1,159 @@
+"""Run a technique's WGSL ``trace`` on arbitrary rays in a compute shader.
+
+The probe composes the same ``trace`` function the fragment shader uses (shaders.compose_technique), so
+what it measures is what the renderer draws. Compare its hits with ``wgpuviewer.reference.exact_hit``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import wgpu
+
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.gpu import Gpu, get_gpu
+
+from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_entries
+from .shaders import compose_technique, pack_trace_params
+from .techniques import TECHNIQUES, get_technique, resolve_params
+
+_RAY_STRIDE = 32  # ProbeRay: vec2f uv, vec2f pad, vec4f view
+_HIT_STRIDE = 32  # ProbeHit: vec2f uv, f32 depth, u32 fetches, u32 capped, u32 layers, vec2u pad
+_WORKGROUP = 64
+_MAX_GROUPS = 65535  # per dispatch dimension
+
+
+@dataclass
+class ProbeResult:
+    uv: np.ndarray  # (N, 2) float32 hit uv, not wrapped
+    depth: np.ndarray  # (N,) float32 hit layer depth t
+    fetches: np.ndarray  # (N,) uint32 depth fetches per ray
+    capped: np.ndarray  # (N,) bool: a cap or clamp decided the result
+    layers: np.ndarray  # (N,) uint32 depth layers the search used (0: technique without layers)
+
+
+def _derived(technique) -> list[str]:
+    """The height-derived slots a technique samples: all the probe binds (it shades nothing)."""
+    return [n for n in technique.textures if MAP_SLOTS[n].derived]
+
+
+def _pipeline(gpu: Gpu, technique_name: str) -> tuple[wgpu.GPUComputePipeline, list]:
+    cache = gpu.cache.setdefault("probe_pipelines", {})
+    if technique_name not in cache:
+        technique = get_technique(technique_name)
+        device = gpu.device
+        module = device.create_shader_module(label=f"probe:{technique.name}",
+                                             code=compose_technique(technique, "probe").code)
+        C = wgpu.ShaderStage.COMPUTE
+        io_layout = device.create_bind_group_layout(
+            label="probe:io",
+            entries=[
+                {"binding": 0, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.read_only_storage}},
+                {"binding": 1, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.storage}},
+            ],
+        )
+        material_layout = device.create_bind_group_layout(
+            label="probe:material",
+            entries=[
+                {"binding": PARAMS_BINDING, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.uniform}},
+                {"binding": SAMPLER_BINDING, "visibility": C, "sampler": {"type": wgpu.SamplerBindingType.filtering}},
+                *layout_entries(_derived(technique), C),
+            ],
+        )
+        layout = device.create_pipeline_layout(label="probe", bind_group_layouts=[io_layout, material_layout])
+        pipeline = device.create_compute_pipeline(
+            label=f"probe:{technique.name}", layout=layout, compute={"module": module, "entry_point": "probe_main"}
+        )
+        cache[technique_name] = (pipeline, [io_layout, material_layout])
+    return cache[technique_name]
+
+
+def probe(
+    technique: str,
+    height: np.ndarray,
+    uv,
+    view_dir,
+    height_scale: float = 0.05,
+    *,
+    address: str = "repeat",
+    backend: str | None = None,
+    **params,
+) -> ProbeResult:
+    """Trace rays with ``technique`` on the GPU.
+
+    height: (H, W) height map in [0, 1] (1 = top; the GPU gets depth = 1 - height). The maps the
+    technique needs are built from it (cached by maptools), exactly as the renderer builds them.
+    uv: (N, 2) entry points; view_dir: (N, 3) or (3,) tangent-space V (towards the eye).
+    params: technique parameters (e.g. ``layers=64``), validated against the registry.
+    """
+    tech = get_technique(technique)
+    if not tech.ray_search:
+        names = ", ".join(name for name, t in TECHNIQUES.items() if t.ray_search)
+        raise UserError(f"technique {technique!r} does not trace rays; ray-search techniques: {names}")
+    values = resolve_params(tech, params)
+    height = np.asarray(height, np.float64)
+    if height.ndim != 2 or height.size == 0:
+        raise UserError(f"probe: height map must be a non-empty 2D array, got shape {height.shape}")
+    if not np.isfinite(height).all():
+        raise UserError("probe: height map contains NaN or inf; clean the data first")
+    if address not in ("repeat", "clamp"):
+        raise UserError(f"probe: address = {address!r}; expected 'repeat' or 'clamp'")
+    uv = np.atleast_2d(np.asarray(uv, np.float32))
+    view = np.atleast_2d(np.asarray(view_dir, np.float32))
+    n = max(len(uv), len(view))
+    uv = np.broadcast_to(uv, (n, 2))
+    view = np.broadcast_to(view, (n, 3))
+    if not (np.isfinite(uv).all() and np.isfinite(view).all()):
+        raise UserError("probe: uv and view_dir must be finite")
+
+    gpu = get_gpu(backend, quiet=True)
+    device = gpu.device
+    pipeline, (io_layout, material_layout) = _pipeline(gpu, tech.name)
+
+    rays = np.zeros((n, _RAY_STRIDE // 4), np.float32)
+    rays[:, 0:2] = uv
+    rays[:, 4:7] = view
+    S = wgpu.BufferUsage
+    ray_buf = device.create_buffer_with_data(label="probe:rays", data=rays, usage=S.STORAGE)
+    hit_buf = device.create_buffer(label="probe:hits", size=n * _HIT_STRIDE, usage=S.STORAGE | S.COPY_SRC)
+    params_buf = device.create_buffer_with_data(
+        label="probe:params", data=pack_trace_params(tech, height_scale, height.shape, values), usage=S.UNIFORM
+    )
+    depth = 1.0 - height
+    maps = [(n, MAP_SLOTS[n].build(gpu, depth, height_scale, f"probe:{n}")) for n in _derived(tech)]
+    mode = wgpu.AddressMode.repeat if address == "repeat" else wgpu.AddressMode.clamp_to_edge
+    sampler = device.create_sampler(
+        label="probe:sampler", address_mode_u=mode, address_mode_v=mode, mag_filter="linear", min_filter="linear"
+    )
+    io_group = device.create_bind_group(
+        layout=io_layout,
+        entries=[
+            {"binding": 0, "resource": {"buffer": ray_buf}},
+            {"binding": 1, "resource": {"buffer": hit_buf}},
+        ],
+    )
+    material_group = device.create_bind_group(
+        layout=material_layout,
+        entries=[
+            {"binding": PARAMS_BINDING, "resource": {"buffer": params_buf}},
+            {"binding": SAMPLER_BINDING, "resource": sampler},
+            *({"binding": binding(name), "resource": texture.create_view()} for name, texture in maps),
+        ],
+    )
+    groups = -(-n // _WORKGROUP)
+    encoder = device.create_command_encoder(label="probe")
+    pass_ = encoder.begin_compute_pass(label="probe")
+    pass_.set_pipeline(pipeline)
+    pass_.set_bind_group(0, io_group)
+    pass_.set_bind_group(1, material_group)
+    # Large ray sets: a 2D grid of workgroups; the shader folds it back into one index.
+    pass_.dispatch_workgroups(min(groups, _MAX_GROUPS), -(-groups // _MAX_GROUPS), 1)
+    pass_.end()
+    device.queue.submit([encoder.finish()])
+    raw = np.frombuffer(device.queue.read_buffer(hit_buf), np.uint8).reshape(n, _HIT_STRIDE)
+    f32 = raw.view(np.float32)
+    u32 = raw.view(np.uint32)
+    return ProbeResult(uv=f32[:, 0:2].copy(), depth=f32[:, 2].copy(), fetches=u32[:, 3].copy(), capped=u32[:, 4] != 0,
+                       layers=u32[:, 5].copy())
+

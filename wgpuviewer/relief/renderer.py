@@ -1,0 +1,364 @@
+"""Drawing a scene with one technique, into a window surface or offscreen.
+
+What to draw comes per draw as a frozen ``DrawConfig`` (technique, its parameters, a height-scale override);
+the renderer holds no per-technique state of its own beyond caches. Everything is built lazily from what the
+drawn technique needs ("model only what a scene needs"): a material's depth texture exists only once a technique
+that traces depth is drawn, pipelines are compiled on first use and cached. ``Renderer.created`` logs each GPU
+resource it builds, so tests (and curious users) can see exactly what a scene cost.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import wgpu
+
+from maptools.cache import cached_generate
+from wgpuviewer import camera as cam
+from wgpuviewer import meshes, textures
+from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
+from wgpuviewer.scene import Camera, Scene
+
+from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_entries
+from .shaders import MAX_LIGHTS, compose_technique, pack_trace_params, trace_params_size
+from .techniques import Technique, get_technique, resolve_params
+
+COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
+DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, depth, fetches
+LAYERS_FORMAT = "r32uint"  # offscreen: depth layers the search used per pixel
+DEPTH_FORMAT = "depth32float"
+#: Byte size of entry/render.wgsl's Frame: view_proj, camera_pos, 8 scalars, lights (a test parses the WGSL).
+FRAME_SIZE = 64 + 16 + 32 + MAX_LIGHTS * 32
+
+#: Frame.mode values (render.wgsl).
+MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4}
+
+#: Formats of the material textures the renderer loads itself (the height-derived ones come from maps.py).
+_MATERIAL_FORMATS = {"albedo": "rgba16float", "normal": "rgba8unorm"}
+
+
+@dataclass(frozen=True)
+class DrawConfig:
+    """What one draw shows: a technique, all its parameter values, and optionally a relief depth (UV units) to
+    trace at instead of each material's own ``height_scale``. Build it with ``DrawConfig.of`` (checks the
+    parameters against the registry) or ``Renderer.config`` (starts from the scene's parameters)."""
+
+    technique: str
+    params: tuple[tuple[str, object], ...]  # (name, value) for every parameter of the technique
+    height_scale: float | None = None
+
+    @classmethod
+    def of(cls, technique: str, params: dict | None = None, height_scale: float | None = None) -> DrawConfig:
+        t = get_technique(technique)
+        return cls(t.name, tuple(resolve_params(t, params).items()), height_scale)
+
+    @property
+    def values(self) -> dict:
+        """The parameter values as a dict (a copy)."""
+        return dict(self.params)
+
+
+@dataclass
+class OffscreenImage:
+    color: np.ndarray  # (H, W, 4) uint8, sRGB; alpha 0 where nothing was drawn
+    data: np.ndarray  # (H, W, 4) float32: hit u, hit v, hit depth, fetches (negative: capped)
+    layers: np.ndarray | None = None  # (H, W) uint32: depth layers the search used (0: no layers)
+    layer_range: tuple[float, float] = (0.0, 1.0)  # the layers mode's grey: (N - lo) / (hi - lo)
+
+    @property
+    def covered(self) -> np.ndarray:
+        return self.color[:, :, 3] > 0
+
+
+class Renderer:
+    def __init__(self, scene: Scene, gpu: Gpu):
+        self.scene = scene
+        self.gpu = gpu
+        self.created: list[str] = []  # GPU resources built, in order: "kind:name"
+        self._textures: dict[tuple[str, str], wgpu.GPUTexture] = {}
+        self._pipelines: dict[tuple, wgpu.GPURenderPipeline] = {}
+        self._material_groups: dict[tuple[str, str], tuple[wgpu.GPUBindGroup, wgpu.GPUBuffer]] = {}
+        self._material_layouts: dict[tuple[str, ...], wgpu.GPUBindGroupLayout] = {}
+        device = gpu.device
+        U = wgpu.BufferUsage
+        V, F = wgpu.ShaderStage.VERTEX, wgpu.ShaderStage.FRAGMENT
+        self._frame_buffer = device.create_buffer(label="frame", size=FRAME_SIZE, usage=U.UNIFORM | U.COPY_DST)
+        self._frame_layout = device.create_bind_group_layout(
+            label="frame", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
+        )
+        self._frame_group = device.create_bind_group(
+            layout=self._frame_layout, entries=[{"binding": 0, "resource": {"buffer": self._frame_buffer}}]
+        )
+        self._object_layout = device.create_bind_group_layout(
+            label="object", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
+        )
+        self._sampler = device.create_sampler(
+            label="material", address_mode_u="repeat", address_mode_v="repeat",
+            mag_filter="linear", min_filter="linear", mipmap_filter="linear", max_anisotropy=1,
+        )
+        self._objects = [self._build_object(i, obj) for i, obj in enumerate(scene.objects)]
+
+    # --- scene geometry (every technique needs it) -------------------------------------------
+
+    def _build_object(self, index: int, obj):
+        device = self.gpu.device
+        vertices = meshes.build(obj.kind, obj.size)
+        vbuf = device.create_buffer_with_data(label=f"mesh:{index}", data=vertices, usage=wgpu.BufferUsage.VERTEX)
+        model = cam.translation(obj.position) @ cam.rotation_xyz(obj.rotation)
+        normal_matrix = np.eye(4)
+        normal_matrix[:3, :3] = np.linalg.inv(model[:3, :3]).T
+        uv_scale = self.scene.materials[obj.material].uv_scale
+        data = np.concatenate([cam.to_wgsl(model).ravel(), cam.to_wgsl(normal_matrix).ravel(), [*uv_scale, 0, 0]])
+        ubuf = device.create_buffer_with_data(
+            label=f"object:{index}", data=data.astype(np.float32), usage=wgpu.BufferUsage.UNIFORM
+        )
+        group = device.create_bind_group(layout=self._object_layout, entries=[{"binding": 0, "resource": {"buffer": ubuf}}])
+        return obj.material, vbuf, len(vertices), group
+
+    # --- lazily built material resources -----------------------------------------------------
+
+    def texture(self, material_name: str, kind: str) -> wgpu.GPUTexture:
+        """The GPU texture of slot ``kind`` (maps.MAP_SLOTS) of a material, built on first use."""
+        key = (material_name, kind)
+        if key not in self._textures:
+            material = self.scene.materials[material_name]
+            label = f"{material_name}.{kind}"
+            slot = MAP_SLOTS[kind]
+            if slot.derived:
+                self._textures[key] = slot.build(self.gpu, self._depth_data(material), material.height_scale, label)
+            else:
+                data = self._normal_data(material) * 0.5 + 0.5 if kind == "normal" else textures.load_albedo(material.albedo)
+                self._textures[key] = create_texture(self.gpu, mip_chain(data), _MATERIAL_FORMATS[kind], label)
+            self.created.append(f"texture:{label}")
+        return self._textures[key]
+
+    @staticmethod
+    def _depth_data(material) -> np.ndarray:
+        if material.height is None:  # no relief: the surface is the top plane
+            return np.zeros((1, 1), np.float32)
+        return textures.load_depth(material.height, material.height_is_depth)
+
+    def _normal_data(self, material) -> np.ndarray:
+        """Normals in the shader's tangent frame: x = u, y = v (image rows down)."""
+        if material.normal is not None:
+            normals = textures.load_normal_map(material.normal, material.normal_y).copy()
+            normals[:, :, 1] *= -1  # OpenGL convention: +y points to image row 0, i.e. towards -v
+            return normals
+        if material.height is None:
+            return np.array([[[0.0, 0.0, 1.0]]], np.float32)
+        height = 1.0 - textures.load_depth(material.height, material.height_is_depth)
+        self.created.append(f"map:{material.name}.normal")
+        # Slopes of the actual relief: height_scale UV units deep over a texture width of 1 UV unit.
+        # maptools' "directx" convention has +y towards increasing rows, which is +v here.
+        strength = material.height_scale * height.shape[1]
+        return cached_generate("normal", height, backend="cpu", strength=strength, y="directx")
+
+    def _material_layout(self, technique: Technique) -> wgpu.GPUBindGroupLayout:
+        if technique.textures not in self._material_layouts:
+            F = wgpu.ShaderStage.FRAGMENT
+            entries = [
+                {"binding": PARAMS_BINDING, "visibility": F, "buffer": {"type": "uniform"}},
+                {"binding": SAMPLER_BINDING, "visibility": F, "sampler": {"type": "filtering"}},
+            ] + layout_entries(technique.textures, F)
+            self._material_layouts[technique.textures] = self.gpu.device.create_bind_group_layout(
+                label="material:" + "+".join(technique.textures), entries=entries
+            )
+        return self._material_layouts[technique.textures]
+
+    def _material_group(self, material_name: str, technique: Technique):
+        key = (material_name, technique.name)
+        if key not in self._material_groups:
+            device = self.gpu.device
+            params = device.create_buffer(
+                label=f"params:{material_name}:{technique.name}",
+                size=trace_params_size(technique),
+                usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST,
+            )
+            entries = [{"binding": PARAMS_BINDING, "resource": {"buffer": params}},
+                       {"binding": SAMPLER_BINDING, "resource": self._sampler}]
+            entries += [
+                {"binding": binding(t), "resource": self.texture(material_name, t).create_view()}
+                for t in technique.textures
+            ]
+            group = device.create_bind_group(layout=self._material_layout(technique), entries=entries)
+            self._material_groups[key] = (group, params)
+        return self._material_groups[key]
+
+    def pipeline(self, technique: Technique, formats: tuple[str, ...]) -> wgpu.GPURenderPipeline:
+        key = (technique.name, formats)
+        if key not in self._pipelines:
+            device = self.gpu.device
+            label = f"render:{technique.name}:{'+'.join(formats)}"
+            module = device.create_shader_module(label=label, code=compose_technique(technique, "render").code)
+            layout = device.create_pipeline_layout(
+                label=label,
+                bind_group_layouts=[self._frame_layout, self._material_layout(technique), self._object_layout],
+            )
+            self._pipelines[key] = device.create_render_pipeline(
+                label=label,
+                layout=layout,
+                vertex={
+                    "module": module,
+                    "entry_point": "vs_main",
+                    "buffers": [{"array_stride": meshes.VERTEX_STRIDE, "attributes": meshes.VERTEX_ATTRIBUTES}],
+                },
+                primitive={"topology": "triangle-list", "cull_mode": "back", "front_face": "ccw"},
+                depth_stencil={"format": DEPTH_FORMAT, "depth_write_enabled": True, "depth_compare": "less"},
+                fragment={
+                    "module": module,
+                    "entry_point": "fs_color" if len(formats) == 1 else "fs_data",
+                    "targets": [{"format": f} for f in formats],
+                },
+            )
+            self.created.append(f"pipeline:{technique.name}:{'+'.join(formats)}")
+        return self._pipelines[key]
+
+    # --- frames ------------------------------------------------------------------------------
+
+    def rebuild_pipelines(self) -> list[tuple[Technique, Exception]]:
+        """Compile every cached pipeline again from the WGSL files (hot reload). A pipeline that fails keeps
+        its previous version; returns (technique, error) for each failure."""
+        failures = []
+        for key in list(self._pipelines):
+            technique = get_technique(key[0])
+            old = self._pipelines.pop(key)
+            try:
+                self.pipeline(technique, key[1])
+            except wgpu.GPUError as error:
+                self._pipelines[key] = old
+                failures.append((technique, error))
+        return failures
+
+    def config(self, technique: str, params: dict | None = None, height_scale: float | None = None) -> DrawConfig:
+        """A DrawConfig for ``technique`` starting from the scene's parameters for it, ``params`` overriding."""
+        name = get_technique(technique).name
+        return DrawConfig.of(name, {**self.scene.technique_params.get(name, {}), **(params or {})}, height_scale)
+
+    def _write_frame(self, camera: Camera, size: tuple[int, int], mode: str, technique: Technique, params: dict):
+        w, h = size
+        view_proj = cam.perspective(camera.fov, w / h, camera.near, camera.far) @ cam.look_at(
+            camera.position, camera.target, camera.up
+        )
+        lights = np.zeros((MAX_LIGHTS, 8), np.float32)
+        for i, light in enumerate(self.scene.lights[:MAX_LIGHTS]):
+            if light.kind == "directional":
+                lights[i, :4] = [*(-np.asarray(light.direction)), 0.0]  # towards the light
+            else:
+                lights[i, :4] = [*light.position, 1.0]
+            lights[i, 4:7] = np.asarray(light.color) * light.intensity
+        header = np.zeros(8, np.float32)
+        header[:3] = camera.position
+        counts = np.array([min(len(self.scene.lights), MAX_LIGHTS), MODES[mode]], np.uint32)
+        scalars = np.array([technique.cost_scale(params), *layer_range(params), 0.0, 0.0, 0.0], np.float32)
+        data = b"".join([cam.to_wgsl(view_proj).tobytes(), header[:4].tobytes(), counts.tobytes(),
+                         scalars.tobytes(), lights.tobytes()])
+        self.gpu.device.queue.write_buffer(self._frame_buffer, 0, data)
+
+    def encode(
+        self,
+        encoder: wgpu.GPUCommandEncoder,
+        color_views: list,
+        depth_view,
+        formats: tuple[str, ...],
+        draw: DrawConfig,
+        camera: Camera,
+        size: tuple[int, int],
+        mode: str = "color",
+        *,
+        clear: bool = True,
+        scissor: tuple[int, int, int, int] | None = None,
+        timestamp_writes: dict | None = None,
+    ) -> None:
+        """Record one frame of ``draw`` into ``color_views`` (1 target: fs_color; 3: fs_data, formats
+        (COLOR_FORMAT, DATA_FORMAT, LAYERS_FORMAT)).
+
+        ``clear=False`` keeps what the targets hold and ``scissor`` (x, y, w, h) limits the drawing:
+        together they put several techniques side by side in one frame. ``timestamp_writes`` goes to
+        the render pass as is (GPU timing).
+        """
+        technique = get_technique(draw.technique)
+        params = draw.values
+        self._write_frame(camera, size, mode, technique, params)
+        pipeline = self.pipeline(technique, formats)
+        groups = {}
+        for material_name in {m for m, *_ in self._objects}:
+            group, params_buffer = self._material_group(material_name, technique)
+            material = self.scene.materials[material_name]
+            depth_shape = self.texture(material_name, "depth").size[1::-1] if technique.needs_depth else (1, 1)
+            height_scale = material.height_scale if draw.height_scale is None else draw.height_scale
+            self.gpu.device.queue.write_buffer(
+                params_buffer, 0, pack_trace_params(technique, height_scale, depth_shape, params)
+            )
+            groups[material_name] = group
+        background = [*self.scene.background, 0.0]
+        attachments = [
+            {
+                "view": v, "load_op": "clear" if clear else "load", "store_op": "store",
+                "clear_value": background if i == 0 else (0, 0, 0, 0),
+            }
+            for i, v in enumerate(color_views)
+        ]
+        rpass = encoder.begin_render_pass(
+            label=f"frame:{technique.name}",
+            color_attachments=attachments,
+            depth_stencil_attachment={
+                "view": depth_view, "depth_load_op": "clear", "depth_store_op": "discard", "depth_clear_value": 1.0,
+            },
+            timestamp_writes=timestamp_writes,
+        )
+        if scissor is not None:
+            rpass.set_scissor_rect(*scissor)
+        rpass.set_pipeline(pipeline)
+        rpass.set_bind_group(0, self._frame_group)
+        for material_name, vbuf, count, object_group in self._objects:
+            rpass.set_bind_group(1, groups[material_name])
+            rpass.set_bind_group(2, object_group)
+            rpass.set_vertex_buffer(0, vbuf)
+            rpass.draw(count)
+        rpass.end()
+
+    def render(self, draw: DrawConfig | str, size: tuple[int, int], camera: Camera | None = None) -> OffscreenImage:
+        """Draw offscreen and read back both the colour and the raw trace data. ``draw``: a DrawConfig, or a
+        technique name (drawn with the scene's parameters for it)."""
+        if isinstance(draw, str):
+            draw = self.config(draw)
+        device = self.gpu.device
+        w, h = size
+        usage = wgpu.TextureUsage.RENDER_ATTACHMENT | wgpu.TextureUsage.COPY_SRC
+        color = device.create_texture(label="offscreen:color", size=(w, h, 1), format=COLOR_FORMAT, usage=usage)
+        data = device.create_texture(label="offscreen:data", size=(w, h, 1), format=DATA_FORMAT, usage=usage)
+        layers = device.create_texture(label="offscreen:layers", size=(w, h, 1), format=LAYERS_FORMAT, usage=usage)
+        depth = device.create_texture(
+            label="offscreen:depth", size=(w, h, 1), format=DEPTH_FORMAT, usage=wgpu.TextureUsage.RENDER_ATTACHMENT
+        )
+        encoder = device.create_command_encoder(label="offscreen")
+        self.encode(
+            encoder, [color.create_view(), data.create_view(), layers.create_view()], depth.create_view(),
+            (COLOR_FORMAT, DATA_FORMAT, LAYERS_FORMAT), draw, camera or self.scene.camera, size,
+        )
+        device.queue.submit([encoder.finish()])
+        return OffscreenImage(
+            color=_read_texture(device, color, 4, np.uint8),
+            data=_read_texture(device, data, 4, np.uint32).view(np.float32),
+            layers=_read_texture(device, layers, 1, np.uint32)[:, :, 0],
+            layer_range=layer_range(draw.values),
+        )
+
+
+def layer_range(params: dict) -> tuple[float, float]:
+    """(lo, hi) of the layers mode's grey (N - lo) / (hi - lo) (render.wgsl's layer_grey gets them in Frame)."""
+    if params.get("max_layers", 0) > 0:
+        return float(params.get("min_layers", 0)), float(params["max_layers"])
+    return 0.0, float(max(params.get("layers", 0), params.get("linear_steps", 0), 1))
+
+
+def _read_texture(device, texture, channels: int, dtype) -> np.ndarray:
+    w, h = texture.size[:2]
+    row = w * channels * np.dtype(dtype).itemsize
+    raw = device.queue.read_texture(
+        {"texture": texture, "mip_level": 0, "origin": (0, 0, 0)},
+        {"offset": 0, "bytes_per_row": row, "rows_per_image": h},
+        (w, h, 1),
+    )
+    return np.frombuffer(raw, dtype).reshape(h, w, channels).copy()

@@ -1,0 +1,72 @@
+"""Technique shader modules: what the registry generates, composed with the technique's WGSL file.
+
+A module = the generated interface (``interface``: the technique's ``TraceParams`` struct, its ``NAME_MIN`` /
+``NAME_MAX`` parameter constants, ``MAX_LAYERS``, and the @group(1) binding lines of the uniform, the sampler and
+every texture slot it needs) + the technique's file (with what it includes from ``wgsl/common/``) + for rendering
+a shading-normal snippet + an entry-point file (``entry/render.wgsl`` or ``entry/probe.wgsl``), composed by
+``wgpuviewer.core.wgsl`` (includes, line map for error locations).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wgpuviewer.core.wgsl import Generated, Module, compose
+
+from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding
+from .techniques import MAX_LAYERS, Technique
+
+#: Render entry constants the renderer sizes its buffers with (generated into entry/render.wgsl's module).
+MAX_LIGHTS = 4
+
+
+def _f32(x: float) -> str:
+    text = repr(float(x))
+    return text if "e" in text or "." in text else text + ".0"
+
+
+def interface(technique: Technique, entry: str) -> Generated:
+    """The WGSL a technique's module must agree on with Python, generated from its registry entry."""
+    fields = list(technique.trace_fields)
+    fields += [f"_pad{i}" for i in range(-len(fields) % 4)]  # uniform size: a multiple of 16 bytes
+    lines = [f"// Generated from the registry entry of technique {technique.name!r} (wgpuviewer/relief).",
+             "struct TraceParams {", *(f"    {name}: f32," for name in fields), "}",
+             f"const MAX_LAYERS: u32 = {MAX_LAYERS}u;"]
+    for p in technique.params:
+        if p.kind is not bool:
+            lines += [f"const {p.name.upper()}_MIN: f32 = {_f32(p.min)};",
+                      f"const {p.name.upper()}_MAX: f32 = {_f32(p.max)};"]
+    if entry == "render":
+        lines.append(f"const MAX_LIGHTS: u32 = {MAX_LIGHTS}u;")
+    lines += [f"@group(1) @binding({PARAMS_BINDING}) var<uniform> trace_params: TraceParams;",
+              f"@group(1) @binding({SAMPLER_BINDING}) var material_sampler: sampler;"]
+    for name in technique.textures:
+        slot = MAP_SLOTS[name]
+        lines += [f"// {name}: {slot.doc}",
+                  f"@group(1) @binding({binding(name)}) var {slot.wgsl_name}: {slot.wgsl_type};"]
+    return Generated(f"<generated: {technique.name} interface>", "\n".join(lines) + "\n")
+
+
+def compose_technique(technique: Technique, entry: str) -> Module:
+    """The module for ``technique`` with entry point file ``entry/ENTRY.wgsl`` ('render' or 'probe')."""
+    parts = [interface(technique, entry), technique.wgsl_file]
+    if entry == "render":
+        parts.append("shading/normal_from_map.wgsl" if "normal" in technique.textures else "shading/normal_flat.wgsl")
+    parts.append(f"entry/{entry}.wgsl")
+    return compose(*parts)
+
+
+def trace_params_size(technique: Technique) -> int:
+    n = len(technique.trace_fields)
+    return 4 * (n + (-n % 4))
+
+
+def pack_trace_params(technique: Technique, height_scale: float, depth_shape: tuple, params: dict) -> np.ndarray:
+    """TraceParams uniform data for ``technique`` (field order of ``Technique.trace_fields``; booleans as 0/1).
+    ``params`` holds the parameter values (missing ones take the registry defaults)."""
+    values = {**technique.defaults(), **params, **dict(technique.fixed),
+              "height_scale": height_scale, "depth_width": depth_shape[1], "depth_height": depth_shape[0]}
+    data = np.zeros(trace_params_size(technique) // 4, np.float32)
+    for i, name in enumerate(technique.trace_fields):
+        data[i] = float(values[name])
+    return data

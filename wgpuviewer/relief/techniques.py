@@ -1,0 +1,233 @@
+"""The technique registry: one entry per WGSL file in ``wgsl/techniques/``.
+
+An entry names what a technique needs (textures and maps, by their slot names in ``maps.MAP_SLOTS``), its
+parameters with defaults and ranges, and whether it is a ray search (then its WGSL defines ``trace`` and the
+probe can run it). Everything WGSL must agree on is generated from the entry (``shaders.interface``): the
+``TraceParams`` uniform (the common fields, then the parameters, then the fixed values), one binding line per
+texture it needs, and ``NAME_MIN`` / ``NAME_MAX`` constants for its numeric parameters.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from wgpuviewer.core.errors import UserError
+
+#: The first fields of every technique's ``TraceParams`` uniform (f32): the material's relief depth and the
+#: depth map's size in texels (for the mip level). The technique's parameters and fixed values follow.
+COMMON_TRACE_FIELDS = ("height_scale", "depth_width", "depth_height")
+
+#: Full heat of the cost view for techniques without a layer bound (fetches per pixel).
+COMMON_COST_SCALE = 64.0
+
+#: Hard cap on any layer count (generated into every technique's WGSL as ``MAX_LAYERS``).
+MAX_LAYERS = 1024
+
+
+@dataclass(frozen=True)
+class Param:
+    name: str
+    default: float
+    min: float
+    max: float
+    kind: type  # int, float or bool
+    doc: str
+
+    def validate(self, value, where: str):
+        """Checked value, or UserError naming ``where`` (e.g. 'scene.toml: techniques.pom.layers')."""
+        expected = {int: "an integer", float: "a number", bool: "true or false"}[self.kind]
+        ok_type = isinstance(value, bool) if self.kind is bool else (
+            isinstance(value, int) and not isinstance(value, bool)
+            if self.kind is int
+            else isinstance(value, (int, float)) and not isinstance(value, bool)
+        )
+        if not ok_type:
+            raise UserError(f"{where} = {value!r}: expected {expected}")
+        if self.kind is not bool and not (self.min <= value <= self.max):
+            raise UserError(f"{where} = {value!r}: out of range, expected {self.min:g} to {self.max:g}")
+        return self.kind(value)
+
+
+@dataclass(frozen=True)
+class Technique:
+    name: str
+    key: str  # default keyboard key in the viewer
+    description: str
+    cost: str  # what it costs, for humans (README table, `wgpuviewer techniques`)
+    textures: tuple[str, ...]  # slot names in maps.MAP_SLOTS: 'albedo', 'normal', 'depth' and derived maps
+    params: tuple[Param, ...] = ()
+    ray_search: bool = False
+    #: The WGSL file: a name in wgsl/techniques/ (default NAME.wgsl) or an absolute path.
+    wgsl: str = ""
+    #: TraceParams values fixed by the technique (not user parameters), e.g. a property of the map it samples.
+    fixed: tuple[tuple[str, float], ...] = ()
+
+    @property
+    def wgsl_file(self) -> str:
+        """The file for the WGSL composer: relative to wgsl/, or absolute."""
+        name = self.wgsl or f"{self.name}.wgsl"
+        return name if name.startswith("/") else f"techniques/{name}"
+
+    @property
+    def trace_fields(self) -> tuple[str, ...]:
+        """Fields of this technique's TraceParams uniform, in order (all f32)."""
+        return COMMON_TRACE_FIELDS + tuple(p.name for p in self.params) + tuple(name for name, _ in self.fixed)
+
+    @property
+    def needs_depth(self) -> bool:
+        return "depth" in self.textures
+
+    def param(self, name: str) -> Param:
+        for p in self.params:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def defaults(self) -> dict:
+        return {p.name: p.kind(p.default) for p in self.params}
+
+    def cost_scale(self, params: dict) -> float:
+        """Fetch count drawn as full heat in the cost view: the search's own bound where its parameters
+        give one (layer and linear searches), else a common scale so techniques compare side by side."""
+        if "layers" in params:
+            return float(params["layers"] + 1)
+        if "max_layers" in params:
+            return float(params["max_layers"] + 1)
+        if "linear_steps" in params:
+            return float(params["linear_steps"] + 1 + params.get("binary_steps", 0))
+        return COMMON_COST_SCALE
+
+
+#: The admissible view cone (half-angle from the normal, degrees) the refined distance map is built for
+#: (maps.py passes it to maptools' distance_refined kind); steeper rays get no refined steps (see distance.wgsl).
+REFINED_MAX_ANGLE = 80.0
+
+_LAYERS_DOC = "layer count: the ray is tested at this many evenly spaced depths"
+
+TECHNIQUES: dict[str, Technique] = {
+    t.name: t
+    for t in (
+        Technique(
+            "basic", "1", "Basic texturing: albedo at the interpolated UV, flat surface normal.",
+            "1 albedo fetch", ("albedo",),
+        ),
+        Technique(
+            "normal", "2", "Normal mapping: per-pixel normals from the normal map, no displacement.",
+            "albedo + normal fetch", ("albedo", "normal"),
+        ),
+        Technique(
+            "parallax", "3",
+            "Parallax (offset) mapping: uv' = uv - V.xy/V.z * depth(uv) * scale; with offset limiting "
+            "the division by V.z is dropped (Welsh), which bounds the offset at grazing angles.",
+            "1 depth fetch", ("albedo", "normal", "depth"),
+            (Param("offset_limiting", False, 0, 1, bool, "drop the 1/V.z factor (bounded offset)"),),
+            ray_search=True,
+        ),
+        Technique(
+            "steep", "4",
+            "Steep parallax mapping: march N depth layers along the view ray, stop at the first layer "
+            "below the surface.",
+            "up to N+1 depth fetches", ("albedo", "normal", "depth"),
+            (Param("layers", 16, 1, MAX_LAYERS, int, _LAYERS_DOC),),
+            ray_search=True,
+        ),
+        Technique(
+            "pom", "5",
+            "Parallax occlusion mapping: steep parallax, then linear interpolation between the last two "
+            "layers (guarded against a zero denominator).",
+            "up to N+1 depth fetches", ("albedo", "normal", "depth"),
+            (Param("layers", 16, 1, MAX_LAYERS, int, _LAYERS_DOC),),
+            ray_search=True,
+        ),
+        Technique(
+            "pom_adaptive", "6",
+            "Adaptive POM (thesis): layer count from the view angle, F = (1-|V.z|)^0.8, and the complexity map C "
+            "at the entry uv: N = int(mix(mix(Nmin, Nmax/2, F), mix(Nmin, Nmax, F), C)) (truncated, as the "
+            "thesis' int()); then the POM search. angle_only: three.js/Godot's N = int(mix(Nmax, Nmin, |V.z|)).",
+            "up to N+1 depth fetches (+1 complexity fetch, not counted)", ("albedo", "normal", "depth", "complexity"),
+            (
+                Param("min_layers", 4, 1, MAX_LAYERS, int, "Nmin: layers at a head-on view"),
+                Param("max_layers", 32, 1, MAX_LAYERS, int, "Nmax: layers at a grazing view on a complex region"),
+                Param("angle_only", False, 0, 1, bool, "ignore the complexity map (three.js/Godot variant)"),
+            ),
+            ray_search=True,
+        ),
+        Technique(
+            "relief", "7",
+            "Relief mapping (Policarpo): linear search in equal depth steps, then binary search between the last "
+            "step above the surface and the first below it.",
+            "up to linear_steps+1+binary_steps depth fetches", ("albedo", "normal", "depth"),
+            (
+                Param("linear_steps", 16, 1, MAX_LAYERS, int, "linear search steps (depth layers)"),
+                Param("binary_steps", 6, 0, 32, int, "binary refinement steps (each halves the bracket)"),
+            ),
+            ray_search=True,
+        ),
+        Technique(
+            "maxmip", "8",
+            "Maximum-mipmap tracing (seed 004): descend a max pyramid over the bilinear cells from the top, skip "
+            "nodes the ray passes above, climb back after a skip; solve the exact per-cell quadratic at the base. "
+            "Finds the first hit of the bilinear surface to float32 precision (repeat addressing).",
+            "pyramid texel per node + one 2x2 gather per base cell", ("albedo", "normal", "depth", "maxmip"),
+            (Param("max_steps", 1024, 1, 65536, int, "cap on traversal steps (capped rays are flagged)"),),
+            ray_search=True,
+        ),
+        Technique(
+            "distance", "9",
+            "Distance-map parallax (Donnelly): sphere tracing through a 3D map of safe radii; where the radius is "
+            "0 the current bilinear cell is solved exactly and skipped if it holds no hit. Never passes a surface.",
+            "one volume fetch per step + one 2x2 gather per exact cell", ("albedo", "normal", "depth", "distance"),
+            (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
+            ray_search=True, fixed=(("cone_cos", -1.0),),
+        ),
+        Technique(
+            "distance_refined", "0",
+            "Distance-map parallax on the visibility-refined map (seed 000): the same tracer as distance "
+            "(distance.wgsl), the map stores longer safe steps for rays within the admissible view cone "
+            f"({REFINED_MAX_ANGLE:g} degrees); steeper rays take only exact cell steps.",
+            "one volume fetch per step + one 2x2 gather per exact cell",
+            ("albedo", "normal", "depth", "distance_refined"),
+            (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
+            ray_search=True, wgsl="distance.wgsl",
+            fixed=(("cone_cos", math.cos(math.radians(REFINED_MAX_ANGLE))),),
+        ),
+        Technique(
+            "cone", "-",
+            "Relaxed cone stepping (Policarpo & Oliveira) on maptools' conservative cone map: steps of "
+            "(D - t) c / (k + c) that never pass the first hit, then binary search of the bracket (the free end "
+            "is returned). Rays usually converge onto the surface and stop within gap_stop of it.",
+            "per cone step 1 depth + 1 cone-map fetch, then binary_steps depth fetches: "
+            "at most 2*iterations + binary_steps",
+            ("albedo", "normal", "depth", "cone"),
+            (
+                Param("iterations", 128, 1, 4096, int, "cap on cone steps (capped rays are flagged, stop short)"),
+                Param("binary_steps", 6, 0, 32, int, "halvings of the bracket once a step ends below the surface"),
+                Param("gap_stop", 1e-4, 0.0, 0.1, float, "stop when the ray is this close above the surface "
+                      "(layer depth t)"),
+            ),
+            ray_search=True,
+        ),
+    )
+}
+
+
+def get_technique(name: str, where: str = "technique") -> Technique:
+    try:
+        return TECHNIQUES[name]
+    except KeyError:
+        raise UserError(f"{where} = {name!r}: unknown technique; expected one of {', '.join(TECHNIQUES)}") from None
+
+
+def resolve_params(technique: Technique, overrides: dict | None = None, where: str = "") -> dict:
+    """Defaults merged with checked overrides (unknown names are errors naming ``where``)."""
+    values = technique.defaults()
+    for name, value in (overrides or {}).items():
+        key = f"{where}{name}" if where else f"{technique.name}.{name}"
+        try:
+            param = technique.param(name)
+        except KeyError:
+            known = ", ".join(p.name for p in technique.params) or "none"
+            raise UserError(f"{key}: unknown parameter of technique {technique.name!r}; known: {known}") from None
+        values[name] = param.validate(value, key)
+    return values

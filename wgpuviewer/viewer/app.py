@@ -1,0 +1,589 @@
+"""The interactive window: rendercanvas (glfw by default, Qt on request) on any wgpu backend.
+
+Compare relief-mapping techniques live: number keys and Left/Right switch techniques, B splits the
+screen between two of them (drag the divider), Shift+D shows the cost (depth fetches per pixel) and
+Shift+E the UV error against a high-layer-count POM reference, both as heat maps with a legend.
+A HUD (imgui) shows FPS/frame/GPU time, the technique's description and live parameters, and the
+keys (F1). Edited WGSL files are recompiled on the fly. Settings persist between sessions
+(``settings``). ``keys.CONTROLS`` lists every key.
+
+Scripted runs (tests, demos): ``frames`` frames, ``keys`` pressed one per frame, the last frame
+(HUD included) saved to ``screenshot``; an ERROR logged while drawing makes the run exit 1.
+
+The viewer owns what the user tunes live: the parameters of each technique (``params``, starting from the scene's)
+and a relief-depth override per technique (``height_scales``); each pass gets them as a frozen
+``DrawConfig`` (``draw_config``).
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import wgpu
+
+from wgpuviewer.camera import normalize
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.gpu import get_gpu
+from wgpuviewer.relief.output import save_rgb_png
+from wgpuviewer.relief.renderer import DEPTH_FORMAT, DrawConfig, Renderer
+from wgpuviewer.relief.techniques import get_technique
+from wgpuviewer.scene import Camera, Scene
+
+from .cameras import FlyCamera, OrbitCamera
+from .keys import FLY_KEYS, PRESSED
+from .settings import LIMITS, Settings, save_settings
+from .stats import FrameStats, GpuTimer
+
+MODES = ("color", "cost", "error")
+
+
+def _canvas_class(gui: str):
+    try:
+        if gui == "glfw":
+            from rendercanvas.glfw import RenderCanvas, loop
+        elif gui == "qt":
+            import importlib
+
+            for qt in ("PySide6", "PyQt6", "PySide2", "PyQt5"):  # rendercanvas.qt uses the one imported
+                try:
+                    importlib.import_module(f"{qt}.QtWidgets")
+                    break
+                except ImportError:
+                    continue
+            from rendercanvas.qt import RenderCanvas, loop
+        else:
+            from rendercanvas.auto import RenderCanvas, loop
+    except ImportError as error:
+        fix = {"glfw": "pip install 'wgpuviewer[window]'", "qt": "pip install PySide6"}.get(gui, "pip install glfw")
+        raise UserError(f"--gui {gui}: the window toolkit is missing ({error}); install it with: {fix}") from None
+    return RenderCanvas, loop
+
+
+class Viewer:
+    def __init__(
+        self,
+        scene: Scene,
+        technique: str,
+        backend: str | None,
+        *,
+        gui: str = "glfw",
+        settings: Settings | None = None,
+        size: tuple[int, int] | None = None,
+        hud: bool = True,
+        scripted: bool = False,
+    ):
+        RenderCanvas, self.loop = _canvas_class(gui)
+        self.gui = gui
+        self.settings = settings or Settings()
+        s = self.settings
+        self.scene = scene
+        self.gpu = get_gpu(backend)
+        self.renderer = Renderer(scene, self.gpu)
+        #: Live parameters per technique (the HUD edits them) and relief-depth overrides per technique.
+        self.params = {name: dict(values) for name, values in scene.technique_params.items()}
+        self.height_scales: dict[str, float] = {}
+        self.techniques = list(scene.techniques)
+        if technique not in self.techniques:
+            self.techniques.append(technique)
+        self.technique = technique
+        self.technique_b = self.techniques[(self.techniques.index(technique) + 1) % len(self.techniques)]
+        self.active_side = "A"
+        self.split = False
+        self.split_x = 0.5
+        self.mode = "color"
+        self.camera_mode = s.camera_mode
+        self.fly = FlyCamera(scene.camera, s.look_sensitivity)
+        self.orbit = OrbitCamera(scene.camera, s.look_sensitivity, s.zoom_sensitivity)
+        self.move_speed = s.move_speed
+        self.show_hud, self.show_stats, self.show_help = s.show_hud, s.show_stats, False
+        self.vsync = s.vsync and not scripted  # scripted runs draw as fast as they can
+        self.fullscreen = False
+        self.messages: list[str] = []
+        self.error_range = 2.0
+        self.error_texels = (1, 1)
+        self.held: set[str] = set()
+        self.drag_from: tuple[float, float] | None = None
+        self.dragging_divider = False
+        self.frame_size = (0, 0)
+        self.scripted = scripted
+        width, height = size or (s.width, s.height)
+        self.canvas = RenderCanvas(
+            title="wgpuviewer", size=(width, height), update_mode="continuous",
+            max_fps=1000 if scripted else 240, vsync=self.vsync,
+        )
+        self.context = self.canvas.get_wgpu_context()
+        self.format = self.context.get_preferred_format(self.gpu.adapter)
+        self._configure()
+        self._depth = None
+        self._last_time = time.perf_counter()
+        self.stats = FrameStats()
+        self.timer = GpuTimer(self.gpu.device) if GpuTimer.available(self.gpu) else None
+        from .shader_reload import ShaderReloader
+
+        self.reloader = ShaderReloader(self.renderer)
+        self._shown_errors: list[str] = []
+        self._error = None  # ErrorOverlay, built on first use
+        self._error_key = None
+        self._error_time = -1e9
+        from . import hud as hud_module
+
+        self.hud = hud_module.Hud(self) if hud and hud_module.AVAILABLE else None
+        if hud and self.hud is None:
+            self.message("no HUD: install imgui-bundle (pip install 'wgpuviewer[window]')")
+        self.canvas.add_event_handler(self.on_key_down, "key_down")
+        self.canvas.add_event_handler(self.on_key_up, "key_up")
+        self.canvas.add_event_handler(self.on_pointer, "pointer_down", "pointer_up", "pointer_move")
+        self.canvas.add_event_handler(self.on_wheel, "wheel")
+        if s.fullscreen:
+            self.set_fullscreen(True)
+        self._update_title()
+
+    def _configure(self):
+        # COPY_SRC lets scripted runs and P read back the frame just drawn.
+        self.context.configure(device=self.gpu.device, format=self.format, usage="RENDER_ATTACHMENT|COPY_SRC")
+
+    # --- state changes (keys and HUD) ----------------------------------------------------------
+
+    def message(self, text: str):
+        self.messages.append(text)
+        print(text, file=sys.stderr)
+
+    @property
+    def cam(self):
+        return self.orbit if self.camera_mode == "orbit" else self.fly
+
+    @property
+    def look_sensitivity(self) -> float:
+        return self.fly.sensitivity
+
+    @look_sensitivity.setter
+    def look_sensitivity(self, value: float):
+        self.fly.sensitivity = self.orbit.sensitivity = float(value)
+
+    def set_mode(self, mode: str):
+        self.mode = mode
+        self._error_key = None
+        self._update_title()
+
+    def toggle_mode(self, mode: str):
+        self.set_mode("color" if self.mode == mode else mode)
+
+    def set_camera_mode(self, mode: str):
+        if mode == self.camera_mode:
+            return
+        # Keep the view: the new camera starts where the old one looks from.
+        current = self.cam.camera()
+        if mode == "orbit":
+            self.orbit.start = replace(self.scene.camera, position=current.position,
+                                       target=self.orbit.target if np.isfinite(self.orbit.target).all()
+                                       else self.scene.camera.target)
+            self.orbit.reset()
+            self.orbit.start = self.scene.camera
+        else:
+            self.fly.position = np.asarray(current.position, np.float64)
+            f = normalize(np.subtract(current.target, current.position))
+            self.fly.yaw = float(np.arctan2(f[0], -f[2]))
+            self.fly.pitch = float(np.arcsin(np.clip(f[1], -1.0, 1.0)))
+        self.camera_mode = mode
+
+    def set_technique(self, name: str):
+        if self.split and self.active_side == "B":
+            self.technique_b = name
+        else:
+            self.technique = name
+        self._update_title()
+
+    def set_vsync(self, on: bool):
+        """Vsync picks the surface present mode (fifo vs immediate/mailbox); it needs a reconfigure."""
+        self.vsync = bool(on)
+        try:
+            self.canvas._vsync = self.vsync  # read by rendercanvas when it creates the surface
+            inner = getattr(self.context, "_wgpu_context", None)
+            if inner is not None:
+                inner._present_info["vsync"] = self.vsync
+            self._configure()
+        except Exception as error:  # noqa: BLE001 -- private hooks of rendercanvas/wgpu may move
+            self.message(f"vsync: could not change the present mode ({error})")
+        self.message(f"vsync {'on' if self.vsync else 'off'}")
+
+    def set_fullscreen(self, on: bool):
+        try:
+            if self.gui == "qt" or hasattr(self.canvas, "showFullScreen"):
+                self.canvas.showFullScreen() if on else self.canvas.showNormal()
+            else:
+                import glfw
+
+                window = self.canvas._window
+                if on:
+                    self._windowed = (glfw.get_window_pos(window), glfw.get_window_size(window))
+                    monitor = glfw.get_primary_monitor()
+                    mode = glfw.get_video_mode(monitor)
+                    glfw.set_window_monitor(window, monitor, 0, 0, mode.size.width, mode.size.height,
+                                            mode.refresh_rate)
+                else:
+                    (x, y), (w, h) = getattr(self, "_windowed", ((100, 100), (self.settings.width, self.settings.height)))
+                    glfw.set_window_monitor(window, None, x, y, w, h, 0)
+            self.fullscreen = on
+        except Exception as error:  # noqa: BLE001 -- e.g. no monitor, or another toolkit
+            self.message(f"fullscreen: not available here ({error})")
+
+    def screenshot(self, texture) -> Path:
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        name = f"wgpuviewer-{Path(self.scene.path).stem if self.scene.path else 'scene'}-{self.technique}-{stamp}.png"
+        path = Path.cwd() / name
+        save_rgb_png(path, self.read_frame(texture))
+        self.message(f"screenshot: {path}")
+        return path
+
+    def reset_stats(self):
+        self.stats.reset()
+
+    def technique_params(self, name: str) -> dict:
+        """The live parameters of technique ``name`` (the dict the HUD edits)."""
+        return self.params.setdefault(name, get_technique(name).defaults())
+
+    def draw_config(self, name: str) -> DrawConfig:
+        """What a pass of technique ``name`` draws: its live parameters and height-scale override."""
+        return DrawConfig.of(name, self.technique_params(name), self.height_scales.get(name))
+
+    def cost_scale(self) -> float:
+        return get_technique(self.technique).cost_scale(self.technique_params(self.technique))
+
+    def material_height_scales(self) -> str:
+        return ", ".join(f"{m.height_scale:g}" for m in self.scene.materials.values())
+
+    def material_height_scale(self) -> float:
+        return float(next(iter(self.scene.materials.values())).height_scale)
+
+    @property
+    def error_reference(self) -> str:
+        from .error_view import REFERENCE, REFERENCE_LAYERS
+
+        return f"{REFERENCE} {REFERENCE_LAYERS} layers"
+
+    # --- input -------------------------------------------------------------------------------
+
+    def key_for(self, technique: str) -> str:
+        """The number key that selects ``technique`` in this scene (its position: 1..9, then 0)."""
+        index = self.techniques.index(technique)
+        return str((index + 1) % 10) if index < 10 else "←/→"
+
+    def press(self, key: str):
+        """What a key does (keys.CONTROLS; also used by scripted runs)."""
+        control = PRESSED.get(key)
+        if control is not None:
+            getattr(self, control.action)(key)
+        self._update_title()
+
+    # --- the actions of keys.CONTROLS (each takes the key pressed) -----------------------------------------
+
+    def pick_technique(self, key: str):
+        number = int(key) or 10  # keys 1..9, then 0 for the 10th
+        if number <= len(self.techniques):
+            self.set_technique(self.techniques[number - 1])
+
+    def cycle_technique(self, key: str):
+        step = 1 if key == "ArrowRight" else -1
+        current = self.technique_b if self.split and self.active_side == "B" else self.technique
+        self.set_technique(self.techniques[(self.techniques.index(current) + step) % len(self.techniques)])
+
+    def reset_camera(self, key: str):
+        self.cam.reset()
+
+    def toggle_cost(self, key: str):
+        self.toggle_mode("cost")
+
+    def toggle_error(self, key: str):
+        self.toggle_mode("error")
+
+    def cycle_mode(self, key: str):
+        self.set_mode(MODES[(MODES.index(self.mode) + 1) % len(MODES)])
+
+    def toggle_split(self, key: str):
+        self.split = not self.split
+        self.active_side = "A"
+
+    def switch_half(self, key: str):
+        self.active_side = "B" if self.active_side == "A" and self.split else "A"
+
+    def toggle_camera(self, key: str):
+        self.set_camera_mode("fly" if self.camera_mode == "orbit" else "orbit")
+
+    def toggle_hud(self, key: str):
+        self.show_hud = not self.show_hud
+
+    def toggle_stats(self, key: str):
+        self.show_stats = not self.show_stats
+
+    def toggle_help(self, key: str):
+        self.show_help = not self.show_help
+
+    def request_screenshot(self, key: str):
+        self._want_screenshot = True
+
+    def toggle_vsync(self, key: str):
+        self.set_vsync(not self.vsync)
+
+    def toggle_fullscreen(self, key: str):
+        self.set_fullscreen(not self.fullscreen)
+
+    def reload_shaders(self, key: str):
+        self.reloader.reload()
+
+    def quit(self, key: str):
+        self.canvas.close()
+
+    def on_key_down(self, event):
+        key = event["key"]
+        if key in FLY_KEYS:
+            self.held.add(key)
+        else:
+            self.press(key)
+
+    def on_key_up(self, event):
+        self.held.discard(event["key"].lower())  # Shift released first: "D" ends the held "d"
+
+    def _divider_hit(self, x: float) -> bool:
+        width = self.canvas.get_logical_size()[0]
+        return self.split and abs(x - self.split_x * width) <= 8
+
+    def on_pointer(self, event):
+        kind = event["event_type"]
+        if kind == "pointer_down" and event["button"] == 1:
+            if self._divider_hit(event["x"]):
+                self.dragging_divider = True
+            else:
+                self.drag_from = (event["x"], event["y"])
+        elif kind == "pointer_up":
+            self.drag_from = None
+            self.dragging_divider = False
+        elif kind == "pointer_move":
+            if self.dragging_divider:
+                width = max(self.canvas.get_logical_size()[0], 1)
+                self.split_x = float(np.clip(event["x"] / width, 0.02, 0.98))
+            elif self.drag_from is not None:
+                self.cam.look(event["x"] - self.drag_from[0], event["y"] - self.drag_from[1])
+                self.drag_from = (event["x"], event["y"])
+
+    def on_wheel(self, event):
+        steps = event["dy"] / 100.0
+        if self.camera_mode == "orbit":
+            self.orbit.zoom(steps)
+        else:
+            lo, hi = LIMITS["move_speed"]
+            self.move_speed = float(np.clip(self.move_speed * 1.1 ** (-steps), lo, hi))
+
+    def _update_title(self):
+        what = f"{self.technique} | {self.technique_b}" if self.split else self.technique
+        self.canvas.set_title(f"wgpuviewer - {self.scene.name} - {what} ({self.mode})")
+
+    # --- frames ------------------------------------------------------------------------------
+
+    def _scene_passes(self, w: int, h: int, camera: Camera) -> list:
+        """(technique, scissor) of the passes that draw the scene: one, or the two halves of A/B."""
+        if not self.split:
+            return [(self.technique, None)]
+        xs = int(np.clip(round(self.split_x * w), 1, w - 1)) if w > 1 else 1
+        return [(self.technique, (0, 0, xs, h)), (self.technique_b, (xs, 0, w - xs, h))]
+
+    def _update_error_view(self, w: int, h: int, camera: Camera, now: float):
+        """Recompute the error map when what it shows changed (at most ~3 times a second)."""
+        from . import error_view
+
+        size = error_view.map_size((w, h))
+        techniques = (self.technique, self.technique_b) if self.split else (self.technique,)
+        draws = [self.draw_config(t) for t in techniques]
+        key = (size, tuple(draws), self.split and round(self.split_x, 3), camera)
+        if key == self._error_key or (self._error_key is not None and now - self._error_time < 0.3):
+            return
+        if self._error is None:
+            self._error = error_view.ErrorOverlay(self.gpu.device, self.format)
+        # One reference per height-scale override in use (each technique is compared on its own relief).
+        references = {}
+        for draw in draws:
+            if draw.height_scale not in references:
+                references[draw.height_scale] = error_view.reference_render(self.renderer, size, camera,
+                                                                            draw.height_scale)
+
+        def error_of(draw):
+            return error_view.error_map(self.renderer, draw, size, camera, references[draw.height_scale])
+
+        values = error_of(draws[0])
+        if self.split:
+            right = error_of(draws[1])
+            xs = int(round(self.split_x * size[0]))
+            values[:, xs:] = right[:, xs:]
+        self.error_texels = error_view.texel_size(self.renderer)
+        self._error.upload(values)
+        self._error_key, self._error_time = key, now
+
+    def draw(self):
+        now = time.perf_counter()
+        dt, self._last_time = min(now - self._last_time, 0.1), now
+        self.stats.tick(now)
+        if self.timer:
+            for ms in self.timer.collect():
+                self.stats.add_gpu_time(ms)
+        self.reloader.poll(now)
+        if self.reloader.errors != self._shown_errors:  # new compile errors (or fixed ones): say so once
+            self._shown_errors = list(self.reloader.errors)
+            for error in self._shown_errors:
+                print(f"shader error: {error}", file=sys.stderr)
+            if not self._shown_errors:
+                self.message("shaders reloaded")
+        if self.held and self.camera_mode == "fly":
+            step = np.sum([FLY_KEYS[k] for k in self.held], axis=0) * self.move_speed * dt
+            self.fly.move(*step)
+        texture = self.context.get_current_texture()
+        w, h = texture.size[:2]
+        if w < 1 or h < 1:
+            raise wgpu.DrawCancelled("zero-sized frame")
+        self.frame_size = (w, h)
+        device = self.gpu.device
+        if self._depth is None or self._depth.size[:2] != (w, h):
+            self._depth = device.create_texture(
+                label="window:depth", size=(w, h, 1), format=DEPTH_FORMAT, usage="RENDER_ATTACHMENT"
+            )
+        camera = self.cam.camera()
+        if self.mode == "error":
+            self._update_error_view(w, h, camera, now)
+        view = texture.create_view()
+        scene_mode = "cost" if self.mode == "cost" else "color"
+        passes = self._scene_passes(w, h, camera)
+        if self.timer:
+            self.timer.begin_frame()
+        # One submit per scene pass: each pass writes the renderer's frame/params uniforms first.
+        for i, (technique, scissor) in enumerate(passes):
+            encoder = device.create_command_encoder(label="window")
+            writes = self.timer.writes(i == 0, i == len(passes) - 1) if self.timer else None
+            self.renderer.encode(
+                encoder, [view], self._depth.create_view(), (self.format,), self.draw_config(technique), camera, (w, h),
+                scene_mode, clear=(i == 0), scissor=scissor, timestamp_writes=writes,
+            )
+            if self.timer and i == len(passes) - 1:
+                self.timer.encode_resolve(encoder)
+            device.queue.submit([encoder.finish()])
+        if self.timer:
+            self.timer.after_submit()
+        encoder = device.create_command_encoder(label="window:overlay")
+        if self.mode == "error" and self._error is not None:
+            self._error.encode(encoder, view, (0, 0, w, h), self.error_range)
+        if getattr(self, "_want_screenshot", False):  # the scene without the HUD
+            self._want_screenshot = False
+            device.queue.submit([encoder.finish()])
+            self.screenshot(texture)
+            encoder = device.create_command_encoder(label="window:hud")
+        if self.hud is not None:
+            self.hud.encode(encoder, view)
+        device.queue.submit([encoder.finish()])
+        return texture
+
+    def read_frame(self, texture) -> np.ndarray:
+        w, h = texture.size[:2]
+        raw = self.gpu.device.queue.read_texture(  # wgpu-py pads the rows to 256 bytes itself
+            {"texture": texture, "mip_level": 0, "origin": (0, 0, 0)},
+            {"offset": 0, "bytes_per_row": w * 4, "rows_per_image": h},
+            (w, h, 1),
+        )
+        pixels = np.frombuffer(raw, np.uint8).reshape(h, w, 4)
+        rgb = pixels[:, :, [2, 1, 0]] if self.format.startswith("bgra") else pixels[:, :, :3]
+        return np.ascontiguousarray(rgb)
+
+    def current_settings(self) -> Settings:
+        """What to persist: window size (when not fullscreen), camera and UI choices, scene, technique."""
+        s = self.settings
+        if not self.fullscreen:
+            lw, lh = self.canvas.get_logical_size()
+            if lw >= LIMITS["width"][0] and lh >= LIMITS["height"][0]:
+                s = replace(s, width=int(round(lw)), height=int(round(lh)))
+        lo, hi = LIMITS["look_sensitivity"]
+        return replace(
+            s, fullscreen=self.fullscreen, vsync=self.vsync, camera_mode=self.camera_mode,
+            move_speed=float(np.clip(self.move_speed, *LIMITS["move_speed"])),
+            look_sensitivity=float(np.clip(self.look_sensitivity, lo, hi)),
+            show_hud=self.show_hud, show_stats=self.show_stats,
+            last_scene=str(self.scene.path) if self.scene.path else "", last_technique=self.technique,
+        )
+
+    def run(self, frames: int | None = None, screenshot: str | None = None, keys: list[str] = ()) -> int:
+        state = {"frame": 0}
+        pending = list(keys)
+        # rendercanvas only logs a failing draw and shows the previous frame: a scripted run must
+        # notice, or a broken shader would pass as a green test.
+        errors = _ErrorLogCounter()
+        for name in ("wgpu", "rendercanvas"):
+            logging.getLogger(name).addHandler(errors)
+
+        def frame():
+            try:
+                if pending:
+                    self.press(pending.pop(0))
+                texture = self.draw()
+                state["frame"] += 1
+                if frames is not None and state["frame"] >= frames:
+                    if screenshot:
+                        save_rgb_png(Path(screenshot), self.read_frame(texture))
+                        print(screenshot)
+                    self.canvas.close()
+            except BaseException as error:
+                # rendercanvas would log it and call us again forever: stop, and report it after the loop.
+                if frames is None and not isinstance(error, UserError):
+                    raise
+                state["error"] = error
+                self.canvas.close()
+
+        self.canvas.request_draw(frame)
+        try:
+            self.loop.run()
+        finally:
+            for name in ("wgpu", "rendercanvas"):
+                logging.getLogger(name).removeHandler(errors)
+        if "error" in state:
+            raise state["error"]
+        if frames is not None and errors.count:
+            print(f"wgpuviewer: error: {errors.count} error(s) logged while drawing", file=sys.stderr)
+            return 1
+        return 0
+
+
+class _ErrorLogCounter(logging.Handler):
+    def __init__(self):
+        super().__init__(level=logging.ERROR)
+        self.count = 0
+
+    def emit(self, record):
+        self.count += 1
+
+
+def run_viewer(
+    scene: Scene, technique: str, *, backend=None, frames=None, screenshot=None, keys=(),
+    gui: str = "glfw", settings: Settings | None = None, size=None, save: bool | None = None,
+) -> int:
+    """Open the window. Interactive runs save the settings on exit (``save``); scripted ones don't."""
+    if frames is not None and frames < 1:
+        raise UserError(f"--frames {frames}: expected a positive number of frames")
+    if screenshot and frames is None:
+        frames = max(len(keys), 0) + 3  # a screenshot implies a scripted run
+    if screenshot and not screenshot.lower().endswith(".png"):
+        raise UserError(f"--screenshot {screenshot}: expected a .png path")
+    unknown = [k for k in keys if k not in PRESSED]
+    if unknown:
+        raise UserError(f"--keys: unknown key {unknown[0]!r}; known: {', '.join(sorted(PRESSED))}")
+    scripted = frames is not None
+    viewer = Viewer(scene, technique, backend, gui=gui, settings=settings, size=size, scripted=scripted)
+    if not scripted:
+        print("keys: F1 help, 1-9 technique, B A/B split, Shift+D cost, Shift+E error, H hide UI, Esc quit",
+              file=sys.stderr)
+    code = viewer.run(frames, screenshot, keys)
+    if save if save is not None else not scripted:
+        try:
+            path = save_settings(viewer.current_settings())
+            print(f"settings saved to {path}", file=sys.stderr)
+        except OSError as error:
+            print(f"wgpuviewer: warning: could not save settings ({error})", file=sys.stderr)
+    return code

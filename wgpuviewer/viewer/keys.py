@@ -1,0 +1,60 @@
+"""The viewer's controls, in one table: what the keys (and the mouse) do. ``Viewer.press`` dispatches on it, the
+help panel (F1) lists it, ``--keys`` checks against it, and the README's keys table is generated from it
+(``markdown_table``; a test compares the two).
+
+Key names are rendercanvas's event keys: Shift+D arrives as "D", so "d" (strafe, held) and "D" (cost view) are
+different keys.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Control:
+    label: str  # as the help panel and the README show it
+    help: str
+    keys: tuple[str, ...] = ()  # event keys that trigger it; () for mouse controls
+    action: str = ""  # the Viewer method called with the key pressed ("" for held and mouse controls)
+
+
+#: Held keys of the fly camera: direction (right, up, forward) each one moves in while held.
+FLY_KEYS = {"w": (0, 0, 1), "s": (0, 0, -1), "a": (-1, 0, 0), "d": (1, 0, 0), "e": (0, 1, 0), "q": (0, -1, 0)}
+
+CONTROLS = (
+    Control("1–9, 0", "pick the technique (in A/B: of the active half); 0 is the tenth",
+            tuple("1234567890"), "pick_technique"),
+    Control("←/→", "previous / next technique (also past the tenth)", ("ArrowLeft", "ArrowRight"), "cycle_technique"),
+    Control("W A S D, Q E", "fly forward/left/back/right, down/up (while held)", tuple(FLY_KEYS)),
+    Control("left drag", "look around (fly) / orbit (orbit camera); drags the A/B divider"),
+    Control("wheel", "zoom (orbit) / move speed (fly)"),
+    Control("O", "fly ↔ orbit camera", ("o", "O"), "toggle_camera"),
+    Control("R", "reset the camera", ("r", "R"), "reset_camera"),
+    Control("Shift+D", "cost view: depth fetches per pixel as a heat map, with a legend", ("D",), "toggle_cost"),
+    Control("Shift+E", "error view: UV error in texels against POM with 512 layers, as a heat map", ("E",),
+            "toggle_error"),
+    Control("M", "cycle colour / cost / error", ("m", "M"), "cycle_mode"),
+    Control("B", "A/B split between two techniques; drag the divider", ("b", "B"), "toggle_split"),
+    Control("Tab", "the half of the A/B split the keys change", ("Tab",), "switch_half"),
+    Control("P", "save a screenshot PNG (scene only) in the current directory", ("p", "P"), "request_screenshot"),
+    Control("C", "reset the statistics", ("c", "C"), "reset_stats"),
+    Control("X", "show/hide the statistics (FPS current/min/avg/max, frame time, GPU time)", ("x", "X"),
+            "toggle_stats"),
+    Control("H", "hide/show all UI", ("h", "H"), "toggle_hud"),
+    Control("F1", "show/hide the keys", ("F1",), "toggle_help"),
+    Control("V", "vsync on/off", ("v", "V"), "toggle_vsync"),
+    Control("F11", "fullscreen on/off", ("F11",), "toggle_fullscreen"),
+    Control("F5", "reload shaders now (edited `wgsl/` files also reload by themselves)", ("F5",), "reload_shaders"),
+    Control("Esc", "quit", ("Escape",), "quit"),
+)
+
+#: Event key -> the control it triggers on press.
+PRESSED = {key: control for control in CONTROLS if control.action for key in control.keys}
+
+
+def markdown_table() -> str:
+    """The README's keys table."""
+    rows = ["| key | action |", "|---|---|"]
+    rows += [f"| {c.label} | {c.help} |" for c in CONTROLS]
+    return "\n".join(rows)

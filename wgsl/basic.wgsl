@@ -1,4 +1,0 @@
-// Basic texturing: the surface is taken as flat, so the ray meets it where it enters.
-fn trace(uv: vec2f, v: vec3f, lod: f32) -> TraceResult {
-    return untraced(uv);
-}

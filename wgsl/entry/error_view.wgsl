@@ -1,0 +1,31 @@
+// The viewer's error view (wgpuviewer/viewer/error_view.py): an r32float texture of per-pixel values painted
+// over part of the frame with the cost view's heat ramp; negative values keep the frame underneath.
+// #include "common/heat.wgsl"
+
+struct Blit {
+    rect: vec4f,      // x, y, w, h of the viewport part in pixels (scissor)
+    max_value: f32,   // value shown as full heat
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+@group(0) @binding(0) var<uniform> blit: Blit;
+@group(0) @binding(1) var values: texture_2d<f32>;
+
+@vertex
+fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
+    let p = vec2f(f32((i << 1u) & 2u), f32(i & 2u));  // fullscreen triangle
+    return vec4f(p * 2.0 - 1.0, 0.0, 1.0);
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    let size = vec2f(textureDimensions(values));
+    let frame = vec2f(blit.rect.z, blit.rect.w);
+    let texel = vec2i(clamp((pos.xy - blit.rect.xy) / frame * size, vec2f(0.0), size - 1.0));
+    let value = textureLoad(values, texel, 0).r;
+    if value < 0.0 {
+        discard;  // nothing drawn there
+    }
+    return vec4f(heat(value / blit.max_value), 1.0);
+}

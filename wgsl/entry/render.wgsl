@@ -1,0 +1,150 @@
+// Rasterisation entry points: vertex transform, then per fragment the technique's `trace` and the
+// thesis' shading model (ambient 0.2 * albedo, Lambert diffuse, Blinn-Phong 0.2 * pow(., 32)).
+// Composed after the generated interface (MAX_LIGHTS among it), one technique file and one shading_normal
+// snippet (wgpuviewer/relief/shaders.py). Frame's layout is checked against renderer.FRAME_SIZE by a test.
+// #include "common/heat.wgsl"
+
+// Frame.mode values of fs_color (the window); offscreen rendering reads fs_data's raw target instead.
+const MODE_COLOR: u32 = 0u;
+const MODE_COST: u32 = 1u;
+const MODE_UV: u32 = 2u;
+const MODE_DEPTH: u32 = 3u;
+const MODE_LAYERS: u32 = 4u;
+
+struct Light {
+    vector: vec4f,  // w = 0: direction towards the light; w = 1: light position
+    color: vec4f,   // rgb * intensity
+}
+
+struct Frame {
+    view_proj: mat4x4f,
+    camera_pos: vec4f,
+    light_count: u32,
+    mode: u32,
+    cost_scale: f32,  // fetch count shown as full heat in MODE_COST
+    layer_lo: f32,    // MODE_LAYERS grey: (N - layer_lo) / (layer_hi - layer_lo) (renderer.layer_range)
+    layer_hi: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+    lights: array<Light, MAX_LIGHTS>,
+}
+
+struct Object {
+    model: mat4x4f,
+    normal_matrix: mat4x4f,
+    uv_scale: vec4f,  // xy: texture repeats across the face
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(2) @binding(0) var<uniform> object: Object;
+
+struct VertexIn {
+    @location(0) position: vec3f,
+    @location(1) normal: vec3f,
+    @location(2) tangent: vec4f,  // w: handedness of the bitangent
+    @location(3) uv: vec2f,
+}
+
+struct VertexOut {
+    @builtin(position) clip: vec4f,
+    @location(0) world_pos: vec3f,
+    @location(1) normal: vec3f,
+    @location(2) tangent: vec4f,
+    @location(3) uv: vec2f,
+}
+
+@vertex
+fn vs_main(in: VertexIn) -> VertexOut {
+    var out: VertexOut;
+    let world = object.model * vec4f(in.position, 1.0);
+    out.clip = frame.view_proj * world;
+    out.world_pos = world.xyz;
+    out.normal = (object.normal_matrix * vec4f(in.normal, 0.0)).xyz;
+    out.tangent = vec4f((object.model * vec4f(in.tangent.xyz, 0.0)).xyz, in.tangent.w);
+    out.uv = in.uv * object.uv_scale.xy;
+    return out;
+}
+
+struct Shaded {
+    color: vec3f,
+    hit: TraceResult,
+}
+
+fn shade(in: VertexOut) -> Shaded {
+    // Derivatives and mip level come from the unperturbed UV, before any non-uniform control flow:
+    // they do not jump where the traced UV does (silhouettes, tiling seams).
+    let duv_dx = dpdx(in.uv);
+    let duv_dy = dpdy(in.uv);
+    let texels = vec2f(trace_params.depth_width, trace_params.depth_height);
+    let footprint = max(dot(duv_dx * texels, duv_dx * texels), dot(duv_dy * texels, duv_dy * texels));
+    let lod = max(0.5 * log2(max(footprint, 1e-12)), 0.0);
+
+    let n_geo = normalize(in.normal);
+    let t_geo = normalize(in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz));
+    let b_geo = cross(n_geo, t_geo) * in.tangent.w;
+    let to_eye = normalize(frame.camera_pos.xyz - in.world_pos);
+    let v_ts = vec3f(dot(to_eye, t_geo), dot(to_eye, b_geo), dot(to_eye, n_geo));
+
+    let hit = trace(in.uv, v_ts, lod);
+    // A displaced UV outside the face means the ray left the relief through its side: a silhouette.
+    if any(hit.uv < vec2f(0.0)) || any(hit.uv > object.uv_scale.xy) {
+        discard;
+    }
+
+    let albedo = textureSampleGrad(albedo_tex, material_sampler, hit.uv, duv_dx, duv_dy).rgb;
+    let n = shading_normal(hit.uv, duv_dx, duv_dy);
+    var color = 0.2 * albedo;
+    for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
+        let light = frame.lights[i];
+        var to_light = light.vector.xyz;
+        var radiance = light.color.rgb;
+        if light.vector.w > 0.5 {
+            let offset = light.vector.xyz - in.world_pos;
+            to_light = offset;
+            radiance /= 1.0 + dot(offset, offset);  // bounded falloff, no singularity at the light
+        }
+        let l_world = normalize(to_light);
+        let l = vec3f(dot(l_world, t_geo), dot(l_world, b_geo), dot(l_world, n_geo));
+        let diffuse = max(dot(l, n), 0.0) * albedo;
+        let specular = 0.2 * pow(max(dot(n, normalize(l + v_ts)), 0.0), 32.0);
+        color += (diffuse + specular) * radiance;
+    }
+    return Shaded(color, hit);
+}
+
+// The thesis' debug view: layer count as grey, (N - Nmin) / (Nmax - Nmin) for techniques with a layer
+// range (pom_adaptive), N / layers for fixed layer counts; black for techniques without layers.
+fn layer_grey(n: u32) -> f32 {
+    return clamp((f32(n) - frame.layer_lo) / max(frame.layer_hi - frame.layer_lo, 1.0), 0.0, 1.0);
+}
+
+// Window/surface output: one target, the Frame.mode decides what is shown.
+@fragment
+fn fs_color(in: VertexOut) -> @location(0) vec4f {
+    let s = shade(in);
+    switch frame.mode {
+        case MODE_COST: { return vec4f(heat(f32(s.hit.fetches) / frame.cost_scale), 1.0); }
+        case MODE_UV: { return vec4f(fract(s.hit.uv), 0.0, 1.0); }
+        case MODE_DEPTH: { return vec4f(vec3f(s.hit.depth), 1.0); }
+        case MODE_LAYERS: { return vec4f(vec3f(layer_grey(s.hit.layers)), 1.0); }
+        default: { return vec4f(s.color, 1.0); }
+    }
+}
+
+struct DataOut {
+    @location(0) color: vec4f,
+    // hit u, hit v, hit depth, fetches (negative: capped), as float bits: float32 targets are not
+    // renderable everywhere (OpenGL ES), 32-bit integer targets are.
+    @location(1) data: vec4u,
+    @location(2) layers: u32,  // depth layers the search used (MODE_LAYERS / the `layers` output mode)
+}
+
+// Offscreen output: the shaded colour plus the raw trace data (uv/depth/cost modes, .npy files).
+@fragment
+fn fs_data(in: VertexOut) -> DataOut {
+    let s = shade(in);
+    let fetches = f32(s.hit.fetches);
+    let data = vec4f(s.hit.uv, s.hit.depth, select(fetches, -fetches - 1.0, s.hit.capped));
+    return DataOut(vec4f(s.color, 1.0), bitcast<vec4u>(data), s.hit.layers);
+}

@@ -1,1 +1,0 @@
-"""Package data: shipped as wgpuviewer.wgsl.maps (see pyproject.toml)."""

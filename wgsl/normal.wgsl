@@ -1,4 +1,0 @@
-// Normal mapping: no displacement; the relief shows only through the shading normal.
-fn trace(uv: vec2f, v: vec3f, lod: f32) -> TraceResult {
-    return untraced(uv);
-}
