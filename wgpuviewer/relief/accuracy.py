@@ -1,7 +1,8 @@
-"""Probe-against-reference measurements: UV error in texels, fetches per ray, capped fraction.
+"""Probe-against-reference measurements: UV error in texels, fetches per ray, capped fraction, and the
+divergence-aware SIMD-tile cost.
 
-Used by the tests, ``wgpuviewer accuracy`` and (later) the benchmark, so every number about a
-technique's error is computed one way.
+Used by the tests, ``wgpuviewer accuracy`` and the benchmark, so every number about a technique's error and cost
+is computed one way.
 """
 
 from __future__ import annotations
@@ -9,6 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from wgpuviewer.core.errors import InputError
 
 from .probe import probe
 from .reference import exact_hit, uv_error_texels, view_dir_from_angles
@@ -26,6 +29,30 @@ class Accuracy:
     fetches_p95: float
     capped: float  # fraction of rays flagged capped
     rays: int
+
+
+#: SIMD group shape for the divergence-aware cost: 8 x 4 = 32 lanes (a warp / wave32), screen tiles of pixels.
+SIMD_TILE = (8, 4)
+
+
+def simd_tile_cost(fetches: np.ndarray, tile: tuple[int, int] = SIMD_TILE, covered: np.ndarray | None = None) -> float:
+    """Mean over screen tiles (``tile`` = (width, height) pixels) of the *maximum* fetch count in the tile: what a
+    SIMD group pays when its lanes run a loop until the slowest one is done. ``fetches`` is (H, W); ``covered``
+    (H, W) bool marks the pixels that ran (others count as absent lanes; tiles with none are skipped). Partial
+    tiles at the right and bottom borders count with the lanes they have. NaN when no pixel is covered."""
+    f = np.asarray(fetches, np.float64)
+    if f.ndim != 2:
+        raise InputError(f"simd_tile_cost: fetches must be a 2D (H, W) array, got shape {f.shape}")
+    tw, th = tile
+    if tw < 1 or th < 1:
+        raise InputError(f"simd_tile_cost: tile = {tile}: expected positive (width, height)")
+    mask = np.ones(f.shape, bool) if covered is None else np.asarray(covered, bool)
+    h, w = f.shape
+    ph, pw = -h % th, -w % tw
+    f = np.pad(np.where(mask, f, -np.inf), ((0, ph), (0, pw)), constant_values=-np.inf)
+    peaks = f.reshape((h + ph) // th, th, (w + pw) // tw, tw).max(axis=(1, 3))
+    used = peaks[np.isfinite(peaks)]
+    return float(used.mean()) if used.size else float("nan")
 
 
 def random_rays(n: int, angle_deg: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
