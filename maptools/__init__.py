@@ -5,6 +5,9 @@ both the fallback and the cross-check, and an entry in :data:`maptools.registry.
 
 Conventions: heights are float32 (H, W) in [0, 1], 1 = top; columns are u (x, right), rows are v with
 row 0 = v near 0 (v increases with the row index).
+
+May import: ``wgpuviewer.core`` and nothing else of ``wgpuviewer`` (the renderer imports maptools, never the
+other way round).
 """
 
 from __future__ import annotations

@@ -12,17 +12,23 @@ import numpy as np
 from wgpuviewer.core.sampling import bilinear
 
 
-def sphere_trace(vol: np.ndarray, uv0, view_dir, height_scale: float, *, stop: float = 1e-3,
-                 max_steps: int = 256) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Trace rays entering at ``uv0`` (N, 2) with tangent-space view vectors ``view_dir`` (N, 3), V.z > 0, through
-    the distance volume ``vol`` (Dz, H, W). Returns (t at the stop point, steps taken, capped flag)."""
-    dz, h, w = vol.shape
+def _rays(uv0, view_dir, who: str) -> tuple[np.ndarray, np.ndarray, int]:
+    """Entry points (N, 2) and view vectors (N, 3) as float64, broadcast against each other; V.z > 0 required."""
     uv0 = np.atleast_2d(np.asarray(uv0, np.float64))
     v = np.atleast_2d(np.asarray(view_dir, np.float64))
     n = max(len(uv0), len(v))
     uv0, v = np.broadcast_to(uv0, (n, 2)), np.broadcast_to(v, (n, 3))
     if not (v[:, 2] > 0).all():
-        raise ValueError("sphere_trace needs V.z > 0 for every ray")
+        raise ValueError(f"{who} needs V.z > 0 for every ray")
+    return uv0, v, n
+
+
+def sphere_trace(vol: np.ndarray, uv0, view_dir, height_scale: float, *, stop: float = 1e-3,
+                 max_steps: int = 256) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Trace rays entering at ``uv0`` (N, 2) with tangent-space view vectors ``view_dir`` (N, 3), V.z > 0, through
+    the distance volume ``vol`` (Dz, H, W). Returns (t at the stop point, steps taken, capped flag)."""
+    dz, h, w = vol.shape
+    uv0, v, n = _rays(uv0, view_dir, "sphere_trace")
     sw = height_scale * w
     norm = np.linalg.norm(v, axis=1)
     wx, wy, wz = -v[:, 0] / norm, -v[:, 1] / norm, v[:, 2] / norm  # unit direction, metric space, Z down
@@ -95,12 +101,7 @@ def cone_trace(cmap: np.ndarray, depth: np.ndarray, uv0, view_dir, height_scale:
     """
 
     rows, cols = depth.shape
-    uv0 = np.atleast_2d(np.asarray(uv0, np.float64))
-    v = np.atleast_2d(np.asarray(view_dir, np.float64))
-    n = max(len(uv0), len(v))
-    uv0, v = np.broadcast_to(uv0, (n, 2)), np.broadcast_to(v, (n, 3))
-    if not (v[:, 2] > 0).all():
-        raise ValueError("cone_trace needs V.z > 0 for every ray")
+    uv0, v, n = _rays(uv0, view_dir, "cone_trace")
     dxy = -v[:, :2] / v[:, 2:3] * height_scale * cols  # texels of u per unit t
     k = np.hypot(dxy[:, 0], dxy[:, 1])
     p0 = uv0 * cols

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.relief.scenes import plane_scene
 from wgpuviewer import camera as cam
 from wgpuviewer import textures
 from wgpuviewer.relief.output import mode_data
@@ -66,24 +67,7 @@ def test_step_faces_the_light_on_its_low_side(tmp_path, gpu, axis):
     assert shaded.min() < flat - 0.1, shaded
 
 
-FRAGMENT_SCENE = """
-[scene]
-techniques = ["pom"]
-[camera]
-position = [0.1, 0.5, 0.8]
-target = [0.0, 0.0, 0.0]
-fov = 50
-[materials.m]
-albedo = [0.8, 0.8, 0.8]
-height = { builtin = "bumps", size = [64, 64] }
-height_scale = 0.08
-[[objects]]
-type = "plane"
-material = "m"
-size = [1.0, 1.0]
-[techniques.pom]
-layers = 256
-"""
+FRAGMENT_SCENE = plane_scene("pom", "layers = 256")
 
 
 def test_fragment_path_matches_the_reference(tmp_path, gpu):

@@ -124,8 +124,8 @@ def test_relief_fetch_bound(gpu, linear, binary):
 @pytest.mark.parametrize("technique", EXACT)
 @pytest.mark.parametrize("name", REAL + HARD)
 def test_exact_tracers_find_the_first_hit(gpu, technique, name):
-    """Float32-exact first hit at 0-85 degrees: never behind the reference hit (no tunnelling through thin walls
-    or spikes), and on the reference surface to a small fraction of a texel."""
+    """Float32-exact first hit at 0-85 degrees: on the reference surface to a small fraction of a texel (that it is
+    never behind the first hit is a contract of every exact tracer: test_contracts.py)."""
     h = height_map(name)
     ref_depth = 1.0 - h
     for angle in (0, 60, 80, 85):
@@ -134,7 +134,6 @@ def test_exact_tracers_find_the_first_hit(gpu, technique, name):
         ref = exact_hit(ref_depth, uv, view, 0.05)
         ok = ~got.capped
         assert ok.mean() >= 0.99, (angle, ok.mean())
-        assert (got.depth[ok] <= ref.t[ok] + T_TOL).all(), (angle, float(np.max(got.depth[ok] - ref.t[ok])))
         err = uv_error_texels(got.uv[ok], ref.uv[ok], (64, 64))
         assert np.percentile(err, 99) <= 0.01 and err.max() <= 0.5, (angle, float(err.max()))
 
@@ -213,26 +212,6 @@ def test_distance_refined_fetches_against_plain(gpu):
         refined = measure("distance_refined", h, angle, rays=1024)
         assert plain.error_p95 <= 0.01 and refined.error_p95 <= 0.01
         assert refined.fetches_mean <= plain.fetches_mean * 1.02, (angle, refined, plain)
-
-
-# --- all new techniques: bounded and flagged at grazing and back-facing views --------------------------------
-
-@pytest.mark.parametrize("technique,params", NEW)
-@pytest.mark.parametrize("name", ("bumps", "spike", "checker"))
-def test_new_techniques_finite_at_grazing_views(gpu, technique, params, name):
-    for angle in (85.0, 89.0, 89.9):
-        uv, view = random_rays(256, angle)
-        got = probe(technique, height_map(name), uv, view, 0.05, **params)
-        assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all()
-        assert ((got.depth >= 0) & (got.depth <= 1)).all()
-
-
-@pytest.mark.parametrize("technique,params", NEW)
-def test_new_techniques_flag_horizontal_and_back_facing_views(gpu, technique, params):
-    views = np.array([[1.0, 0.0, 0.0], [0.6, 0.8, 0.0], [0.0, 0.6, -0.8], [0.0, 0.0, -1.0], [1.0, 0.0, 1e-7]])
-    got = probe(technique, height_map("bumps"), np.full((len(views), 2), 0.3), views, 0.05, **params)
-    assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all()
-    assert got.capped.all()
 
 
 # --- rendering ----------------------------------------------------------------------------------------------

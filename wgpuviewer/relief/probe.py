@@ -18,8 +18,8 @@ from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_en
 from .shaders import compose_technique, pack_trace_params
 from .techniques import TECHNIQUES, get_technique, resolve_params
 
-_RAY_STRIDE = 32  # ProbeRay: vec2f uv, vec2f pad, vec4f view
-_HIT_STRIDE = 32  # ProbeHit: vec2f uv, f32 depth, u32 fetches, u32 capped, u32 layers, vec2u pad
+RAY_STRIDE = 32  # ProbeRay: vec2f uv, vec2f pad, vec4f view
+HIT_STRIDE = 32  # ProbeHit: vec2f uv, f32 depth, u32 fetches, u32 capped, u32 layers, vec2u pad
 _WORKGROUP = 64
 _MAX_GROUPS = 65535  # per dispatch dimension
 
@@ -111,12 +111,12 @@ def probe(
     device = gpu.device
     pipeline, (io_layout, material_layout) = _pipeline(gpu, tech.name)
 
-    rays = np.zeros((n, _RAY_STRIDE // 4), np.float32)
+    rays = np.zeros((n, RAY_STRIDE // 4), np.float32)
     rays[:, 0:2] = uv
     rays[:, 4:7] = view
     S = wgpu.BufferUsage
     ray_buf = device.create_buffer_with_data(label="probe:rays", data=rays, usage=S.STORAGE)
-    hit_buf = device.create_buffer(label="probe:hits", size=n * _HIT_STRIDE, usage=S.STORAGE | S.COPY_SRC)
+    hit_buf = device.create_buffer(label="probe:hits", size=n * HIT_STRIDE, usage=S.STORAGE | S.COPY_SRC)
     params_buf = device.create_buffer_with_data(
         label="probe:params", data=pack_trace_params(tech, height_scale, height.shape, values), usage=S.UNIFORM
     )
@@ -151,7 +151,7 @@ def probe(
     pass_.dispatch_workgroups(min(groups, _MAX_GROUPS), -(-groups // _MAX_GROUPS), 1)
     pass_.end()
     device.queue.submit([encoder.finish()])
-    raw = np.frombuffer(device.queue.read_buffer(hit_buf), np.uint8).reshape(n, _HIT_STRIDE)
+    raw = np.frombuffer(device.queue.read_buffer(hit_buf), np.uint8).reshape(n, HIT_STRIDE)
     f32 = raw.view(np.float32)
     u32 = raw.view(np.uint32)
     return ProbeResult(uv=f32[:, 0:2].copy(), depth=f32[:, 2].copy(), fetches=u32[:, 3].copy(), capped=u32[:, 4] != 0,

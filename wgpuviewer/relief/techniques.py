@@ -10,6 +10,7 @@ texture it needs, and ``NAME_MIN`` / ``NAME_MAX`` constants for its numeric para
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from wgpuviewer.core.errors import UserError
@@ -62,6 +63,11 @@ class Technique:
     wgsl: str = ""
     #: TraceParams values fixed by the technique (not user parameters), e.g. a property of the map it samples.
     fixed: tuple[tuple[str, float], ...] = ()
+    #: Ray searches: the most fetches one ray may count, given the parameters (the contract tests hold every
+    #: ray-search technique to it).
+    fetch_bound: Callable[[dict], int] | None = None
+    #: Finds the first hit of the bilinear surface to float32 precision: never behind the float64 exact hit.
+    exact: bool = False
 
     @property
     def wgsl_file(self) -> str:
@@ -103,7 +109,16 @@ class Technique:
 #: (maps.py passes it to maptools' distance_refined kind); steeper rays get no refined steps (see distance.wgsl).
 REFINED_MAX_ANGLE = 80.0
 
-_LAYERS_DOC = "layer count: the ray is tested at this many evenly spaced depths"
+
+
+def _layer_search(name: str, key: str, description: str) -> Technique:
+    """steep and pom: the same layer march with the same parameter and bound (their WGSL differs in the finish)."""
+    return Technique(
+        name, key, description, "up to N+1 depth fetches", ("albedo", "normal", "depth"),
+        (Param("layers", 16, 1, MAX_LAYERS, int, "layer count: the ray is tested at this many evenly spaced depths"),),
+        ray_search=True, fetch_bound=lambda p: p["layers"] + 1,
+    )
+
 
 TECHNIQUES: dict[str, Technique] = {
     t.name: t
@@ -122,23 +137,17 @@ TECHNIQUES: dict[str, Technique] = {
             "the division by V.z is dropped (Welsh), which bounds the offset at grazing angles.",
             "1 depth fetch", ("albedo", "normal", "depth"),
             (Param("offset_limiting", False, 0, 1, bool, "drop the 1/V.z factor (bounded offset)"),),
-            ray_search=True,
+            ray_search=True, fetch_bound=lambda p: 1,
         ),
-        Technique(
+        _layer_search(
             "steep", "4",
             "Steep parallax mapping: march N depth layers along the view ray, stop at the first layer "
             "below the surface.",
-            "up to N+1 depth fetches", ("albedo", "normal", "depth"),
-            (Param("layers", 16, 1, MAX_LAYERS, int, _LAYERS_DOC),),
-            ray_search=True,
         ),
-        Technique(
+        _layer_search(
             "pom", "5",
             "Parallax occlusion mapping: steep parallax, then linear interpolation between the last two "
             "layers (guarded against a zero denominator).",
-            "up to N+1 depth fetches", ("albedo", "normal", "depth"),
-            (Param("layers", 16, 1, MAX_LAYERS, int, _LAYERS_DOC),),
-            ray_search=True,
         ),
         Technique(
             "pom_adaptive", "6",
@@ -151,7 +160,7 @@ TECHNIQUES: dict[str, Technique] = {
                 Param("max_layers", 32, 1, MAX_LAYERS, int, "Nmax: layers at a grazing view on a complex region"),
                 Param("angle_only", False, 0, 1, bool, "ignore the complexity map (three.js/Godot variant)"),
             ),
-            ray_search=True,
+            ray_search=True, fetch_bound=lambda p: max(p["min_layers"], p["max_layers"]) + 1,
         ),
         Technique(
             "relief", "7",
@@ -162,7 +171,7 @@ TECHNIQUES: dict[str, Technique] = {
                 Param("linear_steps", 16, 1, MAX_LAYERS, int, "linear search steps (depth layers)"),
                 Param("binary_steps", 6, 0, 32, int, "binary refinement steps (each halves the bracket)"),
             ),
-            ray_search=True,
+            ray_search=True, fetch_bound=lambda p: p["linear_steps"] + 1 + p["binary_steps"],
         ),
         Technique(
             "maxmip", "8",
@@ -171,7 +180,7 @@ TECHNIQUES: dict[str, Technique] = {
             "Finds the first hit of the bilinear surface to float32 precision (repeat addressing).",
             "pyramid texel per node + one 2x2 gather per base cell", ("albedo", "normal", "depth", "maxmip"),
             (Param("max_steps", 1024, 1, 65536, int, "cap on traversal steps (capped rays are flagged)"),),
-            ray_search=True,
+            ray_search=True, fetch_bound=lambda p: p["max_steps"], exact=True,
         ),
         Technique(
             "distance", "9",
@@ -179,7 +188,7 @@ TECHNIQUES: dict[str, Technique] = {
             "0 the current bilinear cell is solved exactly and skipped if it holds no hit. Never passes a surface.",
             "one volume fetch per step + one 2x2 gather per exact cell", ("albedo", "normal", "depth", "distance"),
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
-            ray_search=True, fixed=(("cone_cos", -1.0),),
+            ray_search=True, fixed=(("cone_cos", -1.0),), fetch_bound=lambda p: 2 * p["iterations"], exact=True,
         ),
         Technique(
             "distance_refined", "0",
@@ -189,7 +198,7 @@ TECHNIQUES: dict[str, Technique] = {
             "one volume fetch per step + one 2x2 gather per exact cell",
             ("albedo", "normal", "depth", "distance_refined"),
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
-            ray_search=True, wgsl="distance.wgsl",
+            ray_search=True, wgsl="distance.wgsl", fetch_bound=lambda p: 2 * p["iterations"], exact=True,
             fixed=(("cone_cos", math.cos(math.radians(REFINED_MAX_ANGLE))),),
         ),
         Technique(
@@ -206,7 +215,7 @@ TECHNIQUES: dict[str, Technique] = {
                 Param("gap_stop", 1e-4, 0.0, 0.1, float, "stop when the ray is this close above the surface "
                       "(layer depth t)"),
             ),
-            ray_search=True,
+            ray_search=True, fetch_bound=lambda p: 2 * p["iterations"] + p["binary_steps"],
         ),
     )
 }

@@ -5,24 +5,21 @@
 // #include "common/map_buffers.wgsl"
 
 struct Params {
-    src_w: u32,
-    src_h: u32,
-    dst_w: u32,
-    dst_h: u32,
+    src_size: vec2u,  // (w, h) of the child level
+    dst_size: vec2u,  // (ceil(w/2), ceil(h/2))
 };
 
 @compute @workgroup_size(8, 8)
 fn reduce(@builtin(global_invocation_id) gid: vec3u) {
-    if (gid.x >= P.dst_w || gid.y >= P.dst_h) { return; }
-    let x0 = (gid.x * P.src_w) / P.dst_w;
-    let x1 = min(2u * gid.x + 1u, P.src_w - 1u);
-    let y0 = (gid.y * P.src_h) / P.dst_h;
-    let y1 = min(2u * gid.y + 1u, P.src_h - 1u);
-    var m = src[y0 * P.src_w + x0];
-    for (var y = y0; y <= min(y1, y0 + 2u); y++) {      // at most 3 children per axis
-        for (var x = x0; x <= min(x1, x0 + 2u); x++) {
-            m = max(m, src[y * P.src_w + x]);
+    let parent = gid.xy;
+    if (any(parent >= P.dst_size)) { return; }
+    let first = (parent * P.src_size) / P.dst_size;
+    let last = min(min(2u * parent + 1u, P.src_size - 1u), first + 2u);  // at most 3 children per axis
+    var m = src[first.y * P.src_size.x + first.x];
+    for (var y = first.y; y <= last.y; y++) {
+        for (var x = first.x; x <= last.x; x++) {
+            m = max(m, src[y * P.src_size.x + x]);
         }
     }
-    dst[gid.y * P.dst_w + gid.x] = m;
+    dst[parent.y * P.dst_size.x + parent.x] = m;
 }

@@ -1,0 +1,77 @@
+"""What every ray-search technique of the registry promises, tested for each one automatically (a new technique
+gets these tests by being registered): finite results at grazing views, flagged results for views with V.z = 0
+and back-facing ones, fetch counts within the technique's declared bound, and for exact tracers never a hit
+behind the float64 first hit. Technique test files keep only their own claims."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wgpuviewer.relief.accuracy import random_rays
+from wgpuviewer.relief.probe import probe
+from wgpuviewer.relief.reference import exact_hit
+from wgpuviewer.relief.techniques import TECHNIQUES
+from wgpuviewer.textures import builtin_height
+
+RAY_SEARCH = [name for name, t in TECHNIQUES.items() if t.ray_search]
+EXACT = [name for name in RAY_SEARCH if TECHNIQUES[name].exact]
+MAPS = ("bricks", "bumps", "flat0", "flat1", "spike", "step", "wall", "checker")
+#: Float tolerance for "never behind the first hit", in layer depth t (float32 positions and depths).
+T_TOL = 1e-4
+
+
+def height_map(name: str) -> np.ndarray:
+    return builtin_height(name, (64, 64))
+
+
+def test_every_ray_search_declares_a_fetch_bound():
+    for name in RAY_SEARCH:
+        t = TECHNIQUES[name]
+        assert t.fetch_bound is not None and t.fetch_bound(t.defaults()) >= 1, name
+
+
+@pytest.mark.parametrize("technique", RAY_SEARCH)
+@pytest.mark.parametrize("angle", [85.0, 89.0, 89.9])
+def test_grazing_views_are_finite_and_bounded(gpu, technique, angle):
+    bound = TECHNIQUES[technique].fetch_bound(TECHNIQUES[technique].defaults())
+    uv, view = random_rays(256, angle, seed=int(angle * 10))
+    for name in MAPS:
+        got = probe(technique, height_map(name), uv, view, 0.05)
+        assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all(), name
+        assert ((got.depth >= 0) & (got.depth <= 1)).all(), name
+        assert got.fetches.max() <= bound, (name, int(got.fetches.max()), bound)
+
+
+@pytest.mark.parametrize("technique", RAY_SEARCH)
+def test_horizontal_and_back_facing_views_are_finite_and_flagged(gpu, technique):
+    views = np.array([[1.0, 0.0, 0.0], [0.6, 0.8, 0.0], [0.0, 0.6, -0.8], [0.0, 0.0, -1.0], [1.0, 0.0, 1e-7]])
+    uv = np.full((len(views), 2), 0.3)
+    for name in ("bumps", "checker", "flat1"):
+        got = probe(technique, height_map(name), uv, views, 0.05)
+        assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all(), name
+        assert got.capped.all(), (name, got.capped)
+    assert not exact_hit(1.0 - height_map("bumps"), uv, views, 0.05).valid.any()  # the reference declines them
+
+
+@pytest.mark.parametrize("technique", RAY_SEARCH)
+def test_fetches_within_the_declared_bound(gpu, technique):
+    t = TECHNIQUES[technique]
+    bound = t.fetch_bound(t.defaults())
+    for angle in (0.0, 45.0, 80.0):
+        uv, view = random_rays(512, angle, seed=7)
+        for name in ("bricks", "checker", "spike"):
+            got = probe(technique, height_map(name), uv, view, 0.05)
+            assert got.fetches.min() >= 1 and got.fetches.max() <= bound, (name, angle, int(got.fetches.max()))
+
+
+@pytest.mark.parametrize("technique", EXACT)
+@pytest.mark.parametrize("name", MAPS)
+def test_exact_tracers_never_pass_the_first_hit(gpu, technique, name):
+    h = height_map(name)
+    for angle in (0.0, 30.0, 60.0, 80.0, 85.0, 89.0):
+        uv, view = random_rays(512, angle, seed=int(angle))
+        got = probe(technique, h, uv, view, 0.05)
+        ref = exact_hit(1.0 - h, uv, view, 0.05)
+        ok = ref.valid
+        assert (got.depth[ok] <= ref.t[ok] + T_TOL).all(), (angle, float(np.max(got.depth[ok] - ref.t[ok])))

@@ -1,0 +1,122 @@
+"""The rooms and their rules (docs/architecture.md): who may import whom, no import cycles, a docstring per room,
+and the README's keys table generated from the viewer's one key table."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+from wgpuviewer.viewer.keys import markdown_table
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE_MODULES = {"wgpuviewer.scene", "wgpuviewer.textures", "wgpuviewer.meshes", "wgpuviewer.camera"}
+
+
+def module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def project_modules() -> dict[str, Path]:
+    files = [*(ROOT / "wgpuviewer").rglob("*.py"), *(ROOT / "maptools").rglob("*.py")]
+    return {module_name(f): f for f in files}
+
+
+def imports_of(name: str, path: Path, known: set[str]) -> set[str]:
+    """Project modules ``name`` imports anywhere in the file (function-level imports included)."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join(anchor + ([base] if base else []))
+            # `from package import module` depends on the module; `from module import name` on the module.
+            targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in known else base for a in node.names]
+        else:
+            continue
+        for target in targets:
+            while target and target not in known:
+                target = target.rpartition(".")[0]
+            if target and target != name:
+                found.add(target)
+    return found
+
+
+def graph() -> dict[str, set[str]]:
+    modules = project_modules()
+    known = set(modules)
+    return {name: imports_of(name, path, known) for name, path in modules.items()}
+
+
+def room(name: str) -> str:
+    parts = name.split(".")
+    if parts[0] == "maptools":
+        return "maptools"
+    if len(parts) >= 2 and parts[1] in ("core", "relief", "viewer", "bench"):
+        return parts[1]
+    if len(parts) >= 3 and parts[1] == "studies":
+        return f"studies.{parts[2]}"
+    return name
+
+
+def allowed(src: str, dst: str) -> bool:
+    a, b = room(src), room(dst)
+    if a == b or dst in ("wgpuviewer", "wgpuviewer.studies"):
+        return True
+    if a == "core":
+        return False
+    if a == "maptools":
+        return b == "core"
+    if src in SCENE_MODULES:
+        return b == "core" or dst == "wgpuviewer.relief.techniques" or dst in SCENE_MODULES
+    base = b == "core" or dst in SCENE_MODULES or b == "relief"
+    if a == "relief":
+        return b in ("core", "maptools") or dst in SCENE_MODULES
+    if a == "viewer":
+        return base
+    if a == "bench" or a.startswith("studies."):
+        return base or b == "maptools"
+    return True  # cli, __main__ and the documented re-exports
+
+
+def test_rooms_import_only_what_they_may():
+    bad = sorted(f"{src} -> {dst}" for src, dsts in graph().items() for dst in dsts if not allowed(src, dst))
+    assert not bad, "imports against the rules of docs/architecture.md:\n" + "\n".join(bad)
+
+
+def test_no_import_cycles():
+    g = graph()
+    state: dict[str, int] = {}
+    cycles = []
+
+    def visit(node, stack):
+        state[node] = 1
+        for nxt in sorted(g[node]):
+            if state.get(nxt) == 1:
+                cycles.append(" -> ".join(stack[stack.index(nxt):] + [nxt]))
+            elif nxt not in state:
+                visit(nxt, stack + [nxt])
+        state[node] = 2
+
+    for node in sorted(g):
+        if node not in state:
+            visit(node, [node])
+    assert not cycles, "\n".join(cycles)
+
+
+def test_every_room_says_what_lives_there_and_what_it_may_import():
+    for init in [*(ROOT / "wgpuviewer").rglob("__init__.py"), ROOT / "maptools" / "__init__.py"]:
+        if init.parent.name == "wgsl":
+            continue
+        doc = ast.get_docstring(ast.parse(init.read_text())) or ""
+        assert "import" in doc, f"{init.relative_to(ROOT)}: the docstring must say what the room may import"
+
+
+def test_readme_keys_table_is_the_key_table():
+    assert markdown_table() in (ROOT / "README.md").read_text()
