@@ -1,6 +1,7 @@
 """``maptools`` command line: generate one map, batch-generate many, or check GPU against CPU.
 
-Exit codes: 0 success, 1 a batch job or a check failed, 2 a user error (one line on stderr).
+Exit codes: 0 success, 1 a batch job or a check failed, 2 a user error (one line on stderr), 3 an internal error
+(one line; the traceback is saved to a file whose path it prints).
 """
 
 from __future__ import annotations
@@ -15,9 +16,10 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from wgpuviewer.core.cli import OneLineParser, prepare_process, run_command
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.images import HEIGHT_CHANNELS, NAN_POLICIES, read_height
-from wgpuviewer.core.io import atomic_open, remove_stale_temps
+from wgpuviewer.core.io import atomic_open, output_dir, refuse_directory, remove_stale_temps
 
 from . import VERSION, generate, resolve_backend
 from .io import INPUT_EXTS, write_result
@@ -63,7 +65,7 @@ def _parse_sets(items: list[str] | None) -> dict[str, dict]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="maptools", description="Generate maps derived from height maps.")
+    parser = OneLineParser(prog="maptools", description="Generate maps derived from height maps.")
     sub = parser.add_subparsers(dest="command", required=True)
 
     gen = sub.add_parser("generate", help="generate one map from one height map")
@@ -118,6 +120,7 @@ def cmd_generate(args) -> int:
     opts = {o.name: getattr(args, f"opt_{o.name}") for o in kind.options if getattr(args, f"opt_{o.name}") is not None}
     opts = kind.resolve(opts)
     out = Path(args.output)
+    refuse_directory(out, f"{Path(args.input).stem}.{kind.name}{kind.extensions[0]}")
     if out.suffix.lower() not in kind.extensions:
         raise UserError(f"{out}: {kind.name} maps are written as {', '.join(kind.extensions)}")
     height = read_height(args.input, args.channel, args.nan_policy)
@@ -186,10 +189,7 @@ def cmd_batch(args) -> int:
         raise UserError(f"--jobs {args.jobs}: must be >= 1")
     files, missing = collect_inputs(args.inputs)
     files = shard(files, si, sn)
-    outdir = Path(args.output)
-    if outdir.exists() and not outdir.is_dir():
-        raise UserError(f"-o {outdir}: exists and is not a folder")
-    outdir.mkdir(parents=True, exist_ok=True)
+    outdir = output_dir(args.output, "-o")
     backend = resolve_backend(args.backend) if files else "cpu"
 
     rows: list[tuple[str, str, str, str]] = [(p, "-", "FAILED", msg) for p, msg in missing]
@@ -364,17 +364,15 @@ def cmd_kinds(args) -> int:
 
 
 def main(argv=None) -> int:
-    parser = build_parser()
+    """Exit codes (wgpuviewer.core.cli): 0 ok, 1 a batch job or check failed, 2 a user error, 3 an internal error."""
+    prepare_process("maptools")  # before any GPU driver loads
     try:
-        args = parser.parse_args(argv)
-    except SystemExit as exc:  # argparse: usage errors (2) and --help (0)
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # argparse: usage errors (2, one line) and --help (0)
         return int(exc.code or 0)
-    try:
-        return {"generate": cmd_generate, "batch": cmd_batch, "check": cmd_check, "kinds": cmd_kinds,
-                "bench": cmd_bench}[args.command](args)
-    except UserError as exc:
-        print(f"maptools: error: {exc}", file=sys.stderr)
-        return 2
+    commands = {"generate": cmd_generate, "batch": cmd_batch, "check": cmd_check, "kinds": cmd_kinds,
+                "bench": cmd_bench}
+    return run_command("maptools", lambda: commands[args.command](args))
 
 
 if __name__ == "__main__":  # pragma: no cover

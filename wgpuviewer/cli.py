@@ -8,9 +8,9 @@ import os
 import sys
 from pathlib import Path
 
+from wgpuviewer.core.cli import OneLineParser, prepare_process, run_command
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.gpu import BACKEND_CHOICES, BACKEND_ENV
-from wgpuviewer.relief.output import OUTPUT_MODES
+from wgpuviewer.core.io import output_dir, refuse_directory
 
 DEFAULT_SIZE = (1280, 720)
 
@@ -49,6 +49,7 @@ def cmd_render(args) -> int:
     from wgpuviewer.relief.renderer import Renderer
 
     out = Path(args.output)
+    refuse_directory(out, "render.png")
     if out.suffix.lower() not in OUTPUT_SUFFIXES:
         raise UserError(f"-o {out}: unknown output type {out.suffix!r}; use .png (image) or .npy (raw float32 data)")
     scene = load_scene_arg(args.scene)
@@ -63,7 +64,7 @@ def cmd_render(args) -> int:
 def cmd_view(args) -> int:
     from wgpuviewer.viewer.settings import load_settings
 
-    scripted = args.frames is not None or bool(args.screenshot)
+    scripted = args.frames is not None or bool(args.screenshot) or bool(args.keys)
     settings, _warnings = load_settings()  # corrupt/outdated file: defaults + a warning on stderr
     scene_arg, technique_arg = args.scene, args.technique
     window = has_display()
@@ -165,7 +166,7 @@ def cmd_bench(args) -> int:
     options = resolve_options(args.suite, resolution=resolution, heightmaps=names(args.heightmaps, "--heightmaps"),
                               techniques=names(args.techniques, "--techniques"), angles=angles, frames=args.frames,
                               backend=args.backend, command=command)
-    out = Path(args.out)
+    out = output_dir(args.out, "--out")  # before a long run, not after it
     if args.from_csv:
         from wgpuviewer.bench.run import rereport
 
@@ -187,7 +188,10 @@ def cmd_info(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    from wgpuviewer.core.gpu import BACKEND_CHOICES, BACKEND_ENV
+    from wgpuviewer.relief.output import OUTPUT_MODES
+
+    parser = OneLineParser(
         prog="wgpuviewer", description="Relief-mapping techniques on WebGPU: viewer, offscreen renderer, probe."
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -250,15 +254,17 @@ COMMANDS = ("view", "render", "techniques", "accuracy", "bench", "info")
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    """Exit codes (wgpuviewer.core.cli): 0 ok, 1 a check failed, 2 a user error, 3 an internal error."""
+    prepare_process("wgpuviewer")  # before any GPU driver loads
     argv = list(sys.argv[1:] if argv is None else argv)
     if not argv or (argv[0] not in COMMANDS and argv[0] not in ("-h", "--help")):
         argv = ["view", *argv]  # `wgpuviewer [SCENE] [--technique ...]` means view
-    args = parser.parse_args(argv)
-    try:
+
+    def command() -> int:
+        args = build_parser().parse_args(argv)
         return args.func(args)
-    except UserError as error:
-        print(f"wgpuviewer: error: {error}", file=sys.stderr)
-        return error.exit_code
-    except KeyboardInterrupt:
-        return 130
+
+    try:
+        return run_command("wgpuviewer", command)
+    except SystemExit as exit_:  # argparse: --help (0) and usage errors (2, one line)
+        return int(exit_.code or 0)

@@ -29,6 +29,7 @@ import wgpu
 from wgpuviewer.camera import normalize
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import get_gpu
+from wgpuviewer.core.io import refuse_directory
 from wgpuviewer.relief.output import save_rgb_png
 from wgpuviewer.relief.renderer import DEPTH_FORMAT, DrawConfig, Renderer
 from wgpuviewer.relief.techniques import get_technique
@@ -567,10 +568,12 @@ def run_viewer(
     """Open the window. Interactive runs save the settings on exit (``save``); scripted ones don't."""
     if frames is not None and frames < 1:
         raise UserError(f"--frames {frames}: expected a positive number of frames")
-    if screenshot and frames is None:
-        frames = max(len(keys), 0) + 3  # a screenshot implies a scripted run
-    if screenshot and not screenshot.lower().endswith(".png"):
-        raise UserError(f"--screenshot {screenshot}: expected a .png path")
+    if (screenshot or keys) and frames is None:
+        frames = len(keys) + 3  # a screenshot or keys to press imply a scripted run, which ends by itself
+    if screenshot:
+        refuse_directory(screenshot, "shot.png")
+        if not screenshot.lower().endswith(".png"):
+            raise UserError(f"--screenshot {screenshot}: expected a .png path")
     unknown = [k for k in keys if k not in PRESSED]
     if unknown:
         raise UserError(f"--keys: unknown key {unknown[0]!r}; known: {', '.join(sorted(PRESSED))}")
