@@ -14,7 +14,8 @@ from dataclasses import dataclass, replace
 from importlib.resources import files
 from pathlib import Path
 
-from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.errors import FileError, UserError
+from wgpuviewer.core.images import read_header
 from wgpuviewer.relief.techniques import TECHNIQUES, get_technique, resolve_params
 
 from .textures import BUILTINS, MAX_BUILTIN_SIZE, TextureRef
@@ -221,13 +222,15 @@ _TEXTURE_FORMS = "'builtin:NAME', { builtin = NAME, size = [W, H] } or a file pa
 
 
 def _texture(t: _Table, name: str, base: Path, color_ok: bool = False, required: bool = False) -> TextureRef | None:
-    """A texture value (builtin, file or, where ``color_ok``, an RGB array); None when absent."""
+    """A texture value (builtin, file or, where ``color_ok``, an RGB array); None when absent. A file's header is
+    read here (format, size, limits: cheap), so a bad file is reported at once against its key."""
     expected = _TEXTURE_FORMS + (" or an RGB array [r, g, b]" if color_ok else "")
     value = t.get(name, _MISSING if required else None, f"a texture: {expected}")
     if value is None:
         return None
+    origin = f"{t.src}: {t.path(name)} = {_show(value)}"
     if isinstance(value, list) and color_ok:
-        return TextureRef("color", color=t.vector(name, 3, lo=0, hi=1))
+        return TextureRef("color", color=t.vector(name, 3, lo=0, hi=1), origin=origin)
     if isinstance(value, dict):
         spec = _Table(t.src, t.path(name), value, ("builtin", "size"))
         builtin = spec.string("builtin")
@@ -236,24 +239,30 @@ def _texture(t: _Table, name: str, base: Path, color_ok: bool = False, required:
                 and all(isinstance(s, int) and not isinstance(s, bool) and 1 <= s <= MAX_BUILTIN_SIZE
                         for s in size)):
             raise spec.error("size", size, f"expected [width, height], integers 1 to {MAX_BUILTIN_SIZE}")
-        return _builtin_ref(spec, "builtin", builtin, tuple(size))
+        return _builtin_ref(spec, "builtin", builtin, tuple(size), origin)
     if not isinstance(value, str):
         raise t.error(name, value, f"expected a texture: {expected}")
     if value.startswith("builtin:"):
-        return _builtin_ref(t, name, value, (256, 256))
-    path = (base / Path(value).expanduser()).resolve()  # base is ignored for absolute paths
+        return _builtin_ref(t, name, value, (256, 256), origin)
+    return _file_ref(t, name, value, (base / Path(value).expanduser()).resolve())  # base is ignored for absolute
+
+
+def _file_ref(t: _Table, name: str, value, path: Path) -> TextureRef:
+    """A file texture at ``path`` named by key ``name`` (value ``value``), its header checked."""
     if not path.exists():
         raise t.error(name, value, f"file not found (looked for {path})")
-    if not path.is_file():
-        raise t.error(name, value, f"not a file ({path}); expected an image or .npy file")
-    return TextureRef("file", path=path)
+    try:
+        read_header(path)
+    except FileError as error:
+        raise t.error(name, value, error.reason) from None
+    return TextureRef("file", path=path, origin=f"{t.src}: {t.path(name)} = {_show(value)}")
 
 
-def _builtin_ref(t: _Table, key: str, value: str, size: tuple[int, int]) -> TextureRef:
+def _builtin_ref(t: _Table, key: str, value: str, size: tuple[int, int], origin: str) -> TextureRef:
     name = value.removeprefix("builtin:")
     if name not in BUILTINS:
         raise t.error(key, value, f"unknown builtin texture; expected one of {', '.join(BUILTINS)}")
-    return TextureRef("builtin", name=name, size=size)
+    return TextureRef("builtin", name=name, size=size, origin=origin)
 
 
 def _camera(root: _Table) -> Camera:
@@ -405,10 +414,15 @@ def load_scene(path) -> Scene:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise UserError(f"{path}: scene file not found") from None
+    except IsADirectoryError:
+        raise UserError(f"{path}: is a directory; expected a scene .toml file") from None
     except UnicodeDecodeError as e:
         raise UserError(f"{path}: not UTF-8 text ({e.reason} at byte {e.start}); save the scene as UTF-8") from None
     except OSError as e:
         raise UserError(f"{path}: cannot read scene file ({e.strerror})") from None
+    if text.startswith("\ufeff"):
+        raise UserError(f"{path}: starts with a UTF-8 byte-order mark (BOM), which TOML does not allow; "
+                        "save the file as UTF-8 without BOM (most editors: encoding 'UTF-8', not 'UTF-8 with BOM')")
     return parse_scene(text, path)
 
 

@@ -9,6 +9,7 @@ resource it builds, so tests (and curious users) can see exactly what a scene co
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,6 +18,7 @@ import wgpu
 from maptools.cache import cached_generate
 from wgpuviewer import camera as cam
 from wgpuviewer import meshes, textures
+from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 from wgpuviewer.scene import Camera, Scene
 
@@ -126,7 +128,9 @@ class Renderer:
             label = f"{material_name}.{kind}"
             slot = MAP_SLOTS[kind]
             if slot.derived:
-                self._textures[key] = slot.build(self.gpu, self._depth_data(material), material.height_scale, label)
+                depth = self._depth_data(material)
+                with _reported_against_height(material, kind):
+                    self._textures[key] = slot.build(self.gpu, depth, material.height_scale, label)
             else:
                 data = self._normal_data(material) * 0.5 + 0.5 if kind == "normal" else textures.load_albedo(material.albedo)
                 self._textures[key] = create_texture(self.gpu, mip_chain(data), _MATERIAL_FORMATS[kind], label)
@@ -152,7 +156,8 @@ class Renderer:
         # Slopes of the actual relief: height_scale UV units deep over a texture width of 1 UV unit.
         # maptools' "directx" convention has +y towards increasing rows, which is +v here.
         strength = material.height_scale * height.shape[1]
-        return cached_generate("normal", height, backend="cpu", strength=strength, y="directx")
+        with _reported_against_height(material, "normal"):
+            return cached_generate("normal", height, backend="cpu", strength=strength, y="directx")
 
     def _material_layout(self, technique: Technique) -> wgpu.GPUBindGroupLayout:
         if technique.textures not in self._material_layouts:
@@ -344,6 +349,19 @@ class Renderer:
             layers=_read_texture(device, layers, 1, np.uint32)[:, :, 0],
             layer_range=layer_range(draw.values),
         )
+
+
+@contextlib.contextmanager
+def _reported_against_height(material, kind: str):
+    """A map derived from a material's height map that cannot be built (too large for a limit, ...) is reported
+    against the height key of the scene, not against the derived map the user never named."""
+    try:
+        yield
+    except UserError as error:
+        ref = material.height
+        if ref is None or not ref.origin:
+            raise
+        raise ref.error(f"its {kind} map cannot be built: {error}") from None
 
 
 def layer_range(params: dict) -> tuple[float, float]:
