@@ -33,7 +33,7 @@ def cache_key(kind: str, height: np.ndarray, options: dict) -> str:
     h = hashlib.sha256()
     h.update(json.dumps({"shape": list(a.shape), "dtype": str(a.dtype), "kind": kind,
                          "options": options, "version": VERSION}, sort_keys=True).encode())
-    h.update(a.tobytes())
+    h.update(memoryview(a).cast("B"))  # the bytes as they are, no copy
     return h.hexdigest()
 
 

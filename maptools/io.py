@@ -34,11 +34,12 @@ def validate_height(height, what: str = "height map") -> np.ndarray:
     return a
 
 
-def _png_bytes(img: np.ndarray) -> bytes:
+def _png_bytes(img: np.ndarray) -> np.ndarray:
+    """The encoded PNG (a uint8 array: file objects write it without a copy)."""
     ok, buf = cv2.imencode(".png", img)
     if not ok:
         raise UserError("could not encode PNG")
-    return buf.tobytes()
+    return buf
 
 
 def _bits_check(bits: int) -> None:
@@ -53,9 +54,13 @@ def write_normal(f, n: np.ndarray, ext: str, bits: int = 8) -> None:
         return
     _bits_check(bits)
     top = 255 if bits == 8 else 65535
-    rgb = np.clip(np.rint((np.asarray(n, np.float64) + 1.0) * 0.5 * top), 0, top)
-    rgb = rgb.astype(np.uint8 if bits == 8 else np.uint16)
-    f.write(_png_bytes(np.ascontiguousarray(rgb[:, :, ::-1])))  # OpenCV writes BGR
+    n = np.asarray(n)
+    bgr = np.empty(n.shape, np.uint8 if bits == 8 else np.uint16)  # OpenCV writes BGR
+    step = max(1, (1 << 16) // max(n.shape[1], 1))  # float64 in row bands: small temporaries at any size
+    for row in range(0, n.shape[0], step):
+        band = np.asarray(n[row:row + step], np.float64)
+        bgr[row:row + step] = np.clip(np.rint((band + 1.0) * 0.5 * top), 0, top)[:, :, ::-1]
+    f.write(_png_bytes(bgr))
 
 
 def write_complexity(f, c: np.ndarray, ext: str, bits: int = 8) -> None:

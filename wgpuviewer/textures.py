@@ -57,34 +57,40 @@ def reported_against(ref: TextureRef):
         raise ref.error(error.reason) from None
 
 # ----------------------------------------------------------------------------------------------
-# Builtin textures. Each generator maps (width, height) to (height map, albedo). Relief builtins
-# are functions of (u, v) with period 1, so they tile at any size and look the same at any size.
+# Builtin textures. Each generator maps (width, height, rows) to (height map, albedo) of those rows of the
+# texture: builtins are made in row bands, so their float64 temporaries stay small at any size (8192^2 included).
+# Relief builtins are functions of (u, v) with period 1, so they tile at any size and look the same at any size.
 
 _Generated = tuple[np.ndarray, np.ndarray]
+#: Texels generated per band.
+BAND_TEXELS = 1 << 16
 
 
-def _uv(w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
-    """Texel-centre coordinates in [0, 1), each shaped (h, w)."""
-    return np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h)
+def _uv(w: int, h: int, rows: slice) -> tuple[np.ndarray, np.ndarray]:
+    """Texel-centre coordinates in [0, 1) of texture rows ``rows``, each shaped (len(rows), w)."""
+    return np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h)[rows] + 0.5) / h)
 
 
-def _noise(shape: tuple[int, int], seed: int, terms: int = 24, max_freq: int = 12) -> np.ndarray:
-    """Periodic noise (h, w) in [-1, 1]: cosines with integer frequencies (so it tiles) and 1/f
-    amplitudes, summed by an inverse FFT of their sparse spectrum (fast at any size)."""
-    h, w = shape
+def _noise(w: int, h: int, rows: slice, seed: int, terms: int = 24, max_freq: int = 12) -> np.ndarray:
+    """Periodic noise in [-1, 1] at texel centres of rows ``rows``: cosines with integer frequencies (so it
+    tiles) and 1/f amplitudes. Each term is separable, exp(i 2 pi (fx u + fy v)) = column factor x row factor,
+    so a band is one small complex matrix product (terms x band rows) @ (terms x w)."""
     rng = np.random.default_rng(seed)
-    spectrum = np.zeros(shape, np.complex128)
-    total = 0.0
+    fx, fy, weight = [], [], []
     for _ in range(terms):
-        fx, fy = rng.integers(-max_freq, max_freq + 1, 2)
+        f = rng.integers(-max_freq, max_freq + 1, 2)
         phase = rng.uniform(0, 2 * np.pi)
-        if fx == fy == 0:
+        if f[0] == f[1] == 0:
             continue
-        amp = 1.0 / np.hypot(fx, fy)
-        # The FFT samples texel corners; texels are sampled at their centres, half a texel on.
-        spectrum[fy % h, fx % w] += amp * np.exp(1j * (phase + np.pi * (fx / w + fy / h)))
-        total += amp
-    return np.fft.ifft2(spectrum).real * (h * w / total)
+        fx.append(f[0])
+        fy.append(f[1])
+        weight.append(np.exp(1j * phase) / np.hypot(*f))
+    total = float(np.sum(np.abs(weight)))
+    u = (np.arange(w) + 0.5) / w
+    v = (np.arange(h)[rows] + 0.5) / h
+    across = np.exp(2j * np.pi * np.outer(fx, u))  # (terms, w)
+    down = np.exp(2j * np.pi * np.outer(v, fy)) * np.asarray(weight)  # (band rows, terms)
+    return (down @ across).real / total
 
 
 def _smoothstep(e0: float, e1: float, x: np.ndarray) -> np.ndarray:
@@ -97,20 +103,20 @@ def _mix(a, b, t: np.ndarray) -> np.ndarray:
     return np.asarray(a) * (1 - t[..., None]) + np.asarray(b) * t[..., None]
 
 
-def _bricks(w: int, h: int) -> _Generated:
-    rows, cols = 4, 2  # per tile; even row count keeps the half-brick offset periodic
-    u, v = _uv(w, h)
-    y = v * rows
+def _bricks(w: int, h: int, rows: slice) -> _Generated:
+    brick_rows, cols = 4, 2  # per tile; even row count keeps the half-brick offset periodic
+    u, v = _uv(w, h, rows)
+    y = v * brick_rows
     row = np.floor(y).astype(int)
     x = u * cols + 0.5 * (row % 2)
     col = np.floor(x).astype(int) % cols  # a brick cut by the tile edge is one brick
     fx, fy = x - np.floor(x), y - row
     # Distance to the brick's edge in UV units, so the mortar is equally wide both ways.
-    edge = np.minimum(np.minimum(fx, 1 - fx) / cols, np.minimum(fy, 1 - fy) / rows)
+    edge = np.minimum(np.minimum(fx, 1 - fx) / cols, np.minimum(fy, 1 - fy) / brick_rows)
     face = _smoothstep(0.012, 0.03, edge)
     rng = np.random.default_rng(1)
-    brick = rng.random((rows, cols, 3))[row, col]
-    grain = _noise(u.shape, seed=2, max_freq=24)
+    brick = rng.random((brick_rows, cols, 3))[row, col]
+    grain = _noise(w, h, rows, seed=2, max_freq=24)
     height = 0.12 + (0.7 + 0.1 * brick[..., 0]) * face + 0.04 * grain
     red = np.array([0.32, 0.085, 0.045]) * (0.7 + 0.6 * brick[..., 1:2]) + 0.03 * (brick[..., 2:3] - 0.5)
     mortar = np.array([0.4, 0.39, 0.36]) * (1 + 0.15 * grain[..., None])
@@ -118,9 +124,9 @@ def _bricks(w: int, h: int) -> _Generated:
     return height, albedo
 
 
-def _bumps(w: int, h: int) -> _Generated:
+def _bumps(w: int, h: int, rows: slice) -> _Generated:
     cells = 4  # per tile; each dome stays inside its cell, so only the own cell matters
-    u, v = _uv(w, h)
+    u, v = _uv(w, h, rows)
     x, y = u * cells, v * cells
     i, j = np.floor(x).astype(int), np.floor(y).astype(int)
     rng = np.random.default_rng(3)
@@ -129,51 +135,50 @@ def _bumps(w: int, h: int) -> _Generated:
     peak = rng.uniform(0.7, 1.0, (cells, cells))[j, i]
     r = np.hypot(x - i - centre[..., 0], y - j - centre[..., 1]) / radius
     dome = np.clip(1 - r * r, 0, 1) ** 2  # smooth at the rim, so derived normals do not jump
-    ground = 0.08 + 0.05 * _noise(u.shape, seed=4)
+    ground = 0.08 + 0.05 * _noise(w, h, rows, seed=4)
     height = ground + (peak - ground) * dome
     tint = _mix([0.45, 0.37, 0.25], [0.09, 0.26, 0.24], _smoothstep(0.0, 0.15, dome))
-    albedo = tint * (1 + 0.12 * _noise(u.shape, seed=5, max_freq=20)[..., None])
+    albedo = tint * (1 + 0.12 * _noise(w, h, rows, seed=5, max_freq=20)[..., None])
     return height, albedo
 
 
-def _ridges(w: int, h: int) -> _Generated:
-    u, v = _uv(w, h)
+def _ridges(w: int, h: int, rows: slice) -> _Generated:
+    u, v = _uv(w, h, rows)
     # |sin(pi * t)| has period 1 in t: integer ridge count plus a periodic wobble keeps it tileable.
     t = 6 * u + 0.35 * np.sin(2 * np.pi * 2 * v)
-    height = 0.85 * (1 - np.abs(np.sin(np.pi * t))) + 0.07 + 0.05 * _noise(u.shape, seed=6)
+    height = 0.85 * (1 - np.abs(np.sin(np.pi * t))) + 0.07 + 0.05 * _noise(w, h, rows, seed=6)
     albedo = _mix([0.16, 0.1, 0.06], [0.62, 0.47, 0.3], np.clip(height, 0, 1))
     return height, albedo
 
 
-def _test_pattern(height: np.ndarray) -> _Generated:
+def _test_pattern(height: np.ndarray, ys: np.ndarray, xs: np.ndarray) -> _Generated:
     """Albedo for the hard cases: grey by height on a faint 32-texel checker, so motion shows."""
-    ys, xs = np.indices(height.shape)
     check = 0.9 + 0.1 * ((xs // 32 + ys // 32) % 2)
     grey = (0.2 + 0.6 * height) * check
     return height, np.repeat(grey[..., None], 3, axis=2)
 
 
-def _hard(fn: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> Callable[[int, int], _Generated]:
-    """Hard case from a function of texel indices (ys, xs) -> exact 0/1 heights."""
+def _hard(fn: Callable[[np.ndarray, np.ndarray, int, int], np.ndarray]) -> Callable[[int, int, slice], _Generated]:
+    """Hard case from a function of texel indices (ys, xs) and the size (h, w) -> exact 0/1 heights."""
 
-    def generate(w: int, h: int) -> _Generated:
-        ys, xs = np.indices((h, w))
-        return _test_pattern(fn(ys, xs).astype(np.float64))
+    def generate(w: int, h: int, rows: slice) -> _Generated:
+        ys, xs = np.meshgrid(np.arange(h)[rows], np.arange(w), indexing="ij")
+        return _test_pattern(np.asarray(fn(ys, xs, h, w), np.float64), ys, xs)
 
     return generate
 
 
-#: Builtin name -> generator (width, height) -> (height map (h, w), albedo (h, w, 3)).
-BUILTINS: dict[str, Callable[[int, int], _Generated]] = {
+#: Builtin name -> generator (width, height, rows) -> (height map, albedo (..., 3)) of those rows.
+BUILTINS: dict[str, Callable[[int, int, slice], _Generated]] = {
     "bricks": _bricks,
     "bumps": _bumps,
     "ridges": _ridges,
-    "flat0": _hard(lambda ys, xs: np.zeros(xs.shape)),
-    "flat1": _hard(lambda ys, xs: np.ones(xs.shape)),
-    "spike": _hard(lambda ys, xs: (ys == ys.shape[0] // 2) & (xs == xs.shape[1] // 2)),
-    "step": _hard(lambda ys, xs: xs >= xs.shape[1] // 2),
-    "wall": _hard(lambda ys, xs: xs == xs.shape[1] // 2),
-    "checker": _hard(lambda ys, xs: (xs // 8 + ys // 8) % 2),
+    "flat0": _hard(lambda ys, xs, h, w: np.zeros(xs.shape)),
+    "flat1": _hard(lambda ys, xs, h, w: np.ones(xs.shape)),
+    "spike": _hard(lambda ys, xs, h, w: (ys == h // 2) & (xs == w // 2)),
+    "step": _hard(lambda ys, xs, h, w: xs >= w // 2),
+    "wall": _hard(lambda ys, xs, h, w: xs == w // 2),
+    "checker": _hard(lambda ys, xs, h, w: (xs // 8 + ys // 8) % 2),
 }
 
 #: Largest builtin side; the WebGPU default limit for 2D textures, the limit for files too.
@@ -192,9 +197,13 @@ def _builtin(name: str, size: tuple[int, int]) -> _Generated:
     w, h = size
     if not (1 <= w <= MAX_BUILTIN_SIZE and 1 <= h <= MAX_BUILTIN_SIZE):
         raise UserError(f"builtin texture {name!r}: size {size}: expected 1 to {MAX_BUILTIN_SIZE} per side")
-    height, albedo = BUILTINS[name](w, h)
-    height = np.clip(height, 0, 1).astype(np.float32)
-    albedo = np.clip(albedo, 0, 1).astype(np.float32)
+    height, albedo = np.empty((h, w), np.float32), np.empty((h, w, 3), np.float32)
+    step = max(1, BAND_TEXELS // w)
+    for row in range(0, h, step):
+        rows = slice(row, min(row + step, h))
+        band_height, band_albedo = BUILTINS[name](w, h, rows)
+        height[rows] = np.clip(band_height, 0, 1)
+        albedo[rows] = np.clip(band_albedo, 0, 1)
     return _read_only(height), _read_only(albedo)
 
 

@@ -341,4 +341,4 @@ def read_height(path, channel: str = "auto", nan_policy: str = "error", *, is_de
     if lo < 0 or hi > 1:
         what = "depth" if is_depth else "height"
         raise FileError(path, f"{what} values range from {lo:g} to {hi:g}; expected [0, 1] (normalise the data)")
-    return (1 - data if is_depth else data).astype(np.float32)
+    return (1 - data if is_depth else data).astype(np.float32, copy=False)

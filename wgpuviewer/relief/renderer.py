@@ -132,8 +132,14 @@ class Renderer:
                 with _reported_against_height(material, kind):
                     self._textures[key] = slot.build(self.gpu, depth, material.height_scale, label)
             else:
-                data = self._normal_data(material) * 0.5 + 0.5 if kind == "normal" else textures.load_albedo(material.albedo)
+                if kind == "normal":
+                    data = self._normal_data(material)  # our own copy: encoded in place, n * 0.5 + 0.5
+                    data *= 0.5
+                    data += 0.5
+                else:
+                    data = textures.load_albedo(material.albedo)
                 self._textures[key] = create_texture(self.gpu, mip_chain(data), _MATERIAL_FORMATS[kind], label)
+                del data
             self.created.append(f"texture:{label}")
         return self._textures[key]
 
