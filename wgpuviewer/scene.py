@@ -99,6 +99,11 @@ class Scene:
 
 
 OBJECT_SIZES = {"plane": 2, "quad": 2, "box": 3}
+#: Most [[lights]] a scene may have: the renderer's Frame uniform holds them all (32 bytes each), and the
+#: shader loops over the scene's count only.
+MAX_LIGHTS = 256
+#: camera.far / camera.near at most: reversed-Z float depth separates surfaces over this range.
+MAX_DEPTH_RANGE = 1e12
 CHANNELS = ("auto", "r", "g", "b", "a")
 _MISSING = object()
 
@@ -281,6 +286,10 @@ def _camera(root: _Table) -> Camera:
     far = t.number("far", 100.0, lo=0, exclusive=True)
     if far <= near:
         raise t.error("far", t.data.get("far", far), f"expected more than camera.near ({near:g})")
+    if far > near * MAX_DEPTH_RANGE:
+        raise t.error("near", t.data.get("near", near), f"too small for camera.far = {far:g}; expected camera.near "
+                      f">= far / {MAX_DEPTH_RANGE:g} = {far / MAX_DEPTH_RANGE:g} (depth separates surfaces over "
+                      f"that range)")
     return Camera(position, target, up, fov, near, far)
 
 
@@ -383,7 +392,11 @@ def parse_scene(text: str, path: Path | str | None = None) -> Scene:
     section = _Table(src, "scene", doc.get("scene", {}), ("name", "technique", "techniques", "background"))
     technique, techniques, params = _techniques(root, section)
 
-    lights = tuple(_light(src, f"lights[{i}]", x) for i, x in enumerate(root.array_of_tables("lights")))
+    raw_lights = root.array_of_tables("lights")
+    if len(raw_lights) > MAX_LIGHTS:
+        raise UserError(f"{src}: lights: {len(raw_lights)} [[lights]] tables; expected at most {MAX_LIGHTS} "
+                        "(merge lights of the same direction, or drop the faintest)")
+    lights = tuple(_light(src, f"lights[{i}]", x) for i, x in enumerate(raw_lights))
     materials = {
         name: _material(src, name, data, base) for name, data in root.table_of_tables("materials").items()
     }

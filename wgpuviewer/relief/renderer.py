@@ -215,7 +215,8 @@ class Renderer:
                     "buffers": [{"array_stride": meshes.VERTEX_STRIDE, "attributes": meshes.VERTEX_ATTRIBUTES}],
                 },
                 primitive={"topology": "triangle-list", "cull_mode": "back", "front_face": "ccw"},
-                depth_stencil={"format": DEPTH_FORMAT, "depth_write_enabled": True, "depth_compare": "less"},
+                # Reversed Z (camera.perspective): 1 at near, 0 at far; the nearer surface has the greater depth.
+                depth_stencil={"format": DEPTH_FORMAT, "depth_write_enabled": True, "depth_compare": "greater"},
                 fragment={
                     "module": module,
                     "entry_point": "fs_color" if len(formats) == 1 else "fs_data",
@@ -251,8 +252,8 @@ class Renderer:
         view_proj = cam.perspective(camera.fov, w / h, camera.near, camera.far) @ cam.look_at(
             camera.position, camera.target, camera.up
         )
-        lights = np.zeros((MAX_LIGHTS, 8), np.float32)
-        for i, light in enumerate(self.scene.lights[:MAX_LIGHTS]):
+        lights = np.zeros((len(self.scene.lights), 8), np.float32)  # the scene checked the count (MAX_LIGHTS)
+        for i, light in enumerate(self.scene.lights):
             if light.kind == "directional":
                 lights[i, :4] = [*(-np.asarray(light.direction)), 0.0]  # towards the light
             else:
@@ -260,7 +261,7 @@ class Renderer:
             lights[i, 4:7] = np.asarray(light.color) * light.intensity
         header = np.zeros(8, np.float32)
         header[:3] = camera.position
-        counts = np.array([min(len(self.scene.lights), MAX_LIGHTS), MODES[mode]], np.uint32)
+        counts = np.array([len(self.scene.lights), MODES[mode]], np.uint32)
         scalars = np.array([technique.cost_scale(params), *layer_range(params), 0.0, 0.0, 0.0], np.float32)
         data = b"".join([cam.to_wgsl(view_proj).tobytes(), header[:4].tobytes(), counts.tobytes(),
                          scalars.tobytes(), lights.tobytes()])
@@ -314,7 +315,7 @@ class Renderer:
             label=f"frame:{technique.name}",
             color_attachments=attachments,
             depth_stencil_attachment={
-                "view": depth_view, "depth_load_op": "clear", "depth_store_op": "discard", "depth_clear_value": 1.0,
+                "view": depth_view, "depth_load_op": "clear", "depth_store_op": "discard", "depth_clear_value": 0.0,
             },
             timestamp_writes=timestamp_writes,
         )
