@@ -19,7 +19,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from .errors import UserError
+from .errors import FileError, UserError
 
 try:
     import fcntl
@@ -44,11 +44,17 @@ if hasattr(errno, "EDQUOT"):
     _FIXES[errno.EDQUOT] = "the disk quota is exceeded; free some space or choose another folder"
 
 
-def write_error(path, error: OSError) -> UserError:
+class WriteError(FileError):
+    """``path`` cannot be written; ``strerror`` is the system's reason (``reason`` adds the fix)."""
+
+    def __init__(self, path, strerror: str, fix: str):
+        super().__init__(path, f"cannot write ({strerror}); {fix}")
+        self.strerror = strerror
+
+
+def write_error(path, error: OSError) -> WriteError:
     """The one-line UserError for an OSError met while writing ``path``."""
-    reason = error.strerror or str(error)
-    fix = _FIXES.get(error.errno, "choose another folder")
-    return UserError(f"{path}: cannot write ({reason}); {fix}")
+    return WriteError(path, error.strerror or str(error), _FIXES.get(error.errno, "choose another folder"))
 
 
 def _umask() -> int:
@@ -150,6 +156,11 @@ def remove_stale_temps(path) -> int:
     threads writing ``path`` now) stay. Returns how many were removed."""
     path = Path(path)
     return sum(_remove_if_abandoned(tmp) for tmp in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"))
+
+
+def remove_abandoned_temps(folder) -> int:
+    """``remove_stale_temps`` for every output in ``folder``: the temps no live writer holds."""
+    return sum(_remove_if_abandoned(tmp) for tmp in Path(folder).glob(".*.tmp"))
 
 
 def output_dir(path, option: str = "") -> Path:
