@@ -18,7 +18,7 @@ from wgpuviewer.core.errors import FileError, UserError
 from wgpuviewer.core.images import read_header
 from wgpuviewer.relief.techniques import TECHNIQUES, get_technique, resolve_params
 
-from .textures import BUILTINS, MAX_BUILTIN_SIZE, TextureRef
+from .textures import BUILTINS, MAX_BUILTIN_SIZE, TextureRef, find_material_files
 
 Vec3 = tuple[float, float, float]
 
@@ -308,8 +308,12 @@ def _light(src: str, key: str, data) -> Light:
 
 def _material(src: str, name: str, data, base: Path) -> Material:
     t = _Table(src, f"materials.{name}", data,
-               ("albedo", "normal", "normal_y", "height", "depth", "height_scale", "uv_scale", "channel"))
-    albedo = _texture(t, "albedo", base, color_ok=True, required=True)
+               ("folder", "albedo", "normal", "normal_y", "height", "depth", "height_scale", "uv_scale", "channel"))
+    folder = _folder(t, base)
+    albedo = _texture(t, "albedo", base, color_ok=True, required=folder is None) or (folder and folder["albedo"])
+    if albedo is None:
+        raise t.error("folder", t.data["folder"], "has no albedo (NAME_Color, name_diff_1k, albedo, basecolor or "
+                                                  "diffuse); add one, or give albedo = ...")
     normal = _texture(t, "normal", base)
     if normal is not None and normal.kind != "file":
         raise t.error("normal", t.data["normal"],
@@ -318,21 +322,84 @@ def _material(src: str, name: str, data, base: Path) -> Material:
         raise t.error("depth", t.data["depth"], "both height and depth given; expected only one of them")
     is_depth = "depth" in t.data
     height = _texture(t, "depth" if is_depth else "height", base)
+    if folder is not None:  # keys given in the table win over the folder's files
+        normal = normal if "normal" in t.data else folder["normal"]
+        height = height if "height" in t.data or is_depth else folder["height"]
     channel = t.string("channel", "auto", CHANNELS)
     if channel != "auto":
         if height is None or height.kind != "file":
             raise t.error("channel", channel, "applies to a height/depth file only; expected no channel here")
         height = replace(height, channel=channel)
+    default_y = folder["normal_y"] if folder is not None and "normal" not in t.data else "opengl"
     return Material(
         name=name,
         albedo=albedo,
         normal=normal,
-        normal_y=t.string("normal_y", "opengl", ("opengl", "directx")),
+        normal_y=t.string("normal_y", default_y, ("opengl", "directx")),
         height=height,
         height_is_depth=is_depth,
         height_scale=t.number("height_scale", 0.05, 0, 1),
         uv_scale=t.vector("uv_scale", 2, [1.0, 1.0], lo=0, exclusive=True),
     )
+
+
+def _folder(t: _Table, base: Path) -> dict | None:
+    """``folder = "DIR"``: the material's files found by name (textures.find_material_files); None if absent."""
+    value = t.get("folder", None, "a folder path")
+    if value is None:
+        return None
+    if not isinstance(value, str):
+        raise t.error("folder", value, "expected a folder path (a string)")
+    path = (base / Path(value).expanduser()).resolve()
+    if not path.exists():
+        raise t.error("folder", value, f"folder not found (looked for {path})")
+    try:
+        return folder_refs(path, f"{t.src}: {t.path('folder')} = {_show(value)}")
+    except FileError as error:
+        raise t.error("folder", value, error.reason) from None
+
+
+def folder_refs(path: Path, where: str) -> dict:
+    """albedo/normal/height TextureRefs (None where absent) and normal_y of the material folder ``path``; each
+    file's header checked; problems are reported against ``where`` (and the file's name)."""
+    found = find_material_files(path)
+    refs: dict = {"normal_y": found.normal_y}
+    for slot in ("albedo", "normal", "height"):
+        file = getattr(found, slot)
+        refs[slot] = None
+        if file is not None:
+            try:
+                read_header(file)
+            except FileError as error:
+                raise FileError(path, f"{file.name}: {error.reason}") from None
+            refs[slot] = TextureRef("file", path=file, origin=f"{where} ({file.name})")
+    return refs
+
+
+def with_folder_material(scene: Scene, folder: Path) -> Scene:
+    """``scene`` with the material folder ``folder`` on its first plane (``--material DIR``): its albedo, normal
+    and height files found by name, the plane's relief depth and tiling kept."""
+    where = f"--material {folder}"
+    plane = next((i for i, o in enumerate(scene.objects) if o.kind == "plane"), None)
+    if plane is None:
+        raise UserError(f"{where}: the scene {scene.path or scene.name} has no plane to show the material on; "
+                        "use a scene with a [[objects]] type = \"plane\"")
+    if not folder.exists():
+        raise UserError(f"{where}: folder not found (looked for {folder.resolve()})")
+    try:
+        refs = folder_refs(folder.resolve(), where)
+    except FileError as error:
+        raise UserError(f"{where}: {error.reason}") from None
+    if refs["albedo"] is None:
+        raise UserError(f"{where}: no albedo file (NAME_Color, name_diff_1k, albedo, basecolor or diffuse)")
+    old = scene.materials[scene.objects[plane].material]
+    name = f"folder {folder.name}"
+    material = Material(name=name, albedo=refs["albedo"], normal=refs["normal"], normal_y=refs["normal_y"],
+                        height=refs["height"], height_scale=old.height_scale, uv_scale=old.uv_scale)
+    objects = list(scene.objects)
+    objects[plane] = replace(objects[plane], material=name)
+    return replace(scene, materials={**scene.materials, name: material}, objects=tuple(objects),
+                   name=f"{scene.name} with {folder.name}")
 
 
 def _object(src: str, key: str, data, materials: dict[str, Material]) -> SceneObject:

@@ -9,6 +9,7 @@ Loaded arrays are cached (several techniques share them) and returned read-only.
 from __future__ import annotations
 
 import contextlib
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -289,6 +290,82 @@ def load_normal_map(ref: TextureRef, normal_y: str = "opengl") -> np.ndarray:
     if zero:
         raise ref.error(f"{zero} zero-length normals (texels at 0.5 grey); expected a normal map")
     return _read_only((n / length).astype(np.float32))
+
+
+# ----------------------------------------------------------------------------------------------
+# Material folders, as technical artists download them: each file's role is read from its name.
+
+#: Files a material folder may contribute.
+FOLDER_EXTS = (".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".npy")
+#: Name tokens per slot (case-insensitive; names split at non-letters and camel case): ambientCG
+#: (NAME_Color, NAME_NormalGL / NAME_NormalDX, NAME_Displacement), Poly Haven (name_diff_1k, name_nor_gl_1k /
+#: name_nor_dx_1k, name_disp_1k) and the generic albedo|basecolor|diffuse, normal, height|displacement|disp|bump.
+NORMAL_TOKENS = frozenset({"normal", "normals", "normalgl", "normaldx", "nor", "nrm", "norm"})
+HEIGHT_TOKENS = frozenset({"height", "heightmap", "displacement", "disp", "bump"})
+ALBEDO_TOKENS = frozenset({"albedo", "basecolor", "basecolour", "diffuse", "diff", "color", "colour", "col"})
+DIRECTX_TOKENS = frozenset({"dx", "directx", "normaldx"})
+
+
+def name_tokens(name: str) -> set[str]:
+    """Lower-case words of a file stem: split at non-letters/digits and at camel case (NormalGL: normal, gl)."""
+    chunks = [c for c in re.split(r"[^A-Za-z0-9]+", name) if c]
+    words = {c.lower() for c in chunks}
+    for chunk in chunks:
+        words.update(w.lower() for w in re.findall(r"[A-Z]+(?![a-z])|[A-Z]?[a-z]+|\d+[A-Za-z]*", chunk))
+    return words
+
+
+def file_role(path: Path) -> tuple[str, str] | None:
+    """(slot, normal convention) a material-folder file plays by its name, or None: ("normal", "opengl" |
+    "directx"), ("height", ""), ("albedo", ""). Roughness, AO, previews and the like play none."""
+    if path.suffix.lower() not in FOLDER_EXTS:
+        return None
+    words = name_tokens(path.stem)
+    if words & NORMAL_TOKENS:
+        return "normal", "directx" if words & DIRECTX_TOKENS else "opengl"
+    if words & HEIGHT_TOKENS:
+        return "height", ""
+    if words & ALBEDO_TOKENS:
+        return "albedo", ""
+    return None
+
+
+@dataclass(frozen=True)
+class FolderFiles:
+    """What a material folder holds per slot (None where it has nothing), and its normal map's convention."""
+
+    albedo: Path | None
+    normal: Path | None
+    normal_y: str
+    height: Path | None
+
+
+def find_material_files(folder: Path) -> FolderFiles:
+    """The albedo, normal and height files of a material folder (``file_role``). Where a folder has both an
+    OpenGL and a DirectX normal map (ambientCG ships both), the OpenGL one is taken; two candidates for one slot
+    are an error listing them. Raises FileError (reason: what was found and the fix)."""
+    if not folder.is_dir():
+        raise FileError(folder, "not a folder; expected a material folder (e.g. an ambientCG or Poly Haven download)")
+    found: dict[str, list[tuple[Path, str]]] = {"albedo": [], "normal": [], "height": []}
+    for path in sorted(p for p in folder.iterdir() if p.is_file()):
+        role = file_role(path)
+        if role is not None:
+            found[role[0]].append((path, role[1]))
+    gl = [c for c in found["normal"] if c[1] == "opengl"]
+    normals = gl or found["normal"]  # OpenGL first: the shader's convention, and ambientCG's NormalGL
+    for slot, candidates in (("albedo", found["albedo"]), ("normal", normals), ("height", found["height"])):
+        if len(candidates) > 1:
+            names = ", ".join(p.name for p, _ in candidates)
+            raise FileError(folder, f"{len(candidates)} candidates for the {slot}: {names}; keep one in the folder "
+                                    f"or name the file in the scene ({slot} = \"...\")")
+    if not any(found.values()):
+        raise FileError(folder, "no albedo, normal or height file recognised by name (expected e.g. "
+                                "NAME_Color/NAME_NormalGL/NAME_Displacement, name_diff_1k/name_nor_gl_1k/name_disp_1k, "
+                                "or albedo/normal/height)")
+    return FolderFiles(albedo=found["albedo"][0][0] if found["albedo"] else None,
+                       normal=normals[0][0] if normals else None,
+                       normal_y=normals[0][1] if normals else "opengl",
+                       height=found["height"][0][0] if found["height"] else None)
 
 
 def clear_cache() -> None:

@@ -12,11 +12,13 @@ wgpu or OpenCV load.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
 import stat
 import sys
 import tempfile
+import threading
 import time
 import traceback
 from collections.abc import Callable
@@ -89,6 +91,41 @@ def _warnings_as_lines(prog: str) -> None:
         logger = logging.getLogger(name)
         logger.handlers = [h for h in logger.handlers if not isinstance(h, _WarningLine)]
         logger.addHandler(_WarningLine(prog))
+
+
+@contextlib.contextmanager
+def terminal_progress(what: str, delay: float = 1.0):
+    """Yields ``progress(label, done, total)`` feeding a tqdm bar on stderr: shown once the work has taken
+    ``delay`` seconds, only on a terminal, redrawn every half second (its clock runs during one long step, e.g.
+    a 3D distance map), gone when the work ends."""
+    from tqdm import tqdm
+
+    state: dict = {}
+    stop = threading.Event()
+
+    def tick():
+        while not stop.wait(0.5):
+            bar = state.get("bar")
+            if bar is not None and time.monotonic() - state["start"] >= delay:
+                bar.refresh()
+
+    def progress(label: str, done: int, total: int) -> None:
+        if "bar" not in state:
+            state["start"] = time.monotonic()
+            state["bar"] = tqdm(total=total, desc=what, unit="map", file=sys.stderr, delay=delay, disable=None,
+                                leave=False, dynamic_ncols=True)
+            threading.Thread(target=tick, daemon=True).start()
+        bar = state["bar"]
+        bar.total = total
+        bar.set_postfix_str(label, refresh=False)
+        bar.update(done - bar.n)
+
+    try:
+        yield progress
+    finally:
+        stop.set()
+        if "bar" in state:
+            state["bar"].close()
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -10,6 +10,7 @@ resource it builds, so tests (and curious users) can see exactly what a scene co
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,6 +120,24 @@ class Renderer:
         return obj.material, vbuf, len(vertices), group
 
     # --- lazily built material resources -----------------------------------------------------
+
+    def missing(self, technique: str) -> list[tuple[str, str]]:
+        """(material, slot) of the textures drawing ``technique`` needs and the renderer has not built yet."""
+        t = get_technique(technique)
+        used = dict.fromkeys(m for m, *_ in self._objects)  # scene order, each once
+        return [(m, k) for m in used for k in t.textures if (m, k) not in self._textures]
+
+    def prepare(self, technique: str, progress: Callable[[str, int, int], None] | None = None) -> None:
+        """Build every texture ``technique`` needs now (loading files, deriving maps), reporting each step as
+        ``progress(label, done, total)``: what ``render``/``encode`` would otherwise build on first use. The
+        viewer calls it from a worker thread while it keeps drawing; problems raise UserError naming the key."""
+        todo = self.missing(technique)
+        for done, (material, kind) in enumerate(todo):
+            if progress is not None:
+                progress(f"{material}.{kind}", done, len(todo))
+            self.texture(material, kind)
+        if progress is not None:
+            progress("done", len(todo), len(todo))
 
     def texture(self, material_name: str, kind: str) -> wgpu.GPUTexture:
         """The GPU texture of slot ``kind`` (maps.MAP_SLOTS) of a material, built on first use."""

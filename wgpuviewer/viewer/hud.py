@@ -75,7 +75,7 @@ class Hud:
             self._legend(width, height)
         if v.split:
             self._split_labels(width)
-        self._status(flags, height)
+        self._status(flags, width, height)
 
     def _stats_panel(self, flags) -> None:
         v = self.viewer
@@ -223,17 +223,26 @@ class Hud:
             draw.add_text(pos, yellow if tag == v.active_side else white, text)
         self.drawn_panels.append("split")
 
-    def _status(self, flags, height) -> None:
+    def _status(self, flags, width, height) -> None:
         v = self.viewer
         lines = [(RED, e) for e in v.reloader.errors] if v.reloader else []
+        problem = v.current_problem()
+        if problem:
+            lines.append((RED, problem))
+        if v.build is not None:
+            lines.append((YELLOW, v.build.line()))
+            self.drawn_panels.append("progress")
         lines += [(WHITE, m) for m in v.messages[-3:]]
         if not lines:
             return
         imgui.set_next_window_pos((10, height - (110 if v.split else 80)), imgui.Cond_.always, (0.0, 1.0))
+        imgui.set_next_window_size_constraints((0, 0), (max(width - 20, 60), height / 2))
         imgui.set_next_window_bg_alpha(0.7)
         imgui.begin("Status", None, flags | imgui.WindowFlags_.no_title_bar)
+        imgui.push_text_wrap_pos(max(width - 40, 40))  # long paths wrap instead of leaving the screen
         for colour, text in lines:
             imgui.text_colored(colour, text)
+        imgui.pop_text_wrap_pos()
         imgui.end()
         self.drawn_panels.append("status")
 
