@@ -637,6 +637,18 @@ class _ErrorLogCounter(logging.Handler):
         self.count += 1
 
 
+def save_session(settings: Settings) -> None:
+    """Save the settings at the end of a session; a folder that cannot be written is a warning naming it and
+    the variable that moves it, never a failed session."""
+    try:
+        path = save_settings(settings)
+        print(f"settings saved to {path}", file=sys.stderr)
+    except (OSError, UserError) as error:
+        reason = getattr(error, "strerror", None) or str(error)
+        print(f"wgpuviewer: warning: settings not saved: {settings_path()} cannot be written ({reason}); "
+              f"set {CONFIG_ENV} to a writable folder", file=sys.stderr)
+
+
 def run_viewer(
     scene: Scene, technique: str, *, backend=None, frames=None, screenshot=None, keys=(),
     gui: str = "glfw", settings: Settings | None = None, size=None, save: bool | None = None,
@@ -660,13 +672,7 @@ def run_viewer(
               file=sys.stderr)
     code = viewer.run(frames, screenshot, keys)
     if save if save is not None else not scripted:
-        try:
-            path = save_settings(viewer.current_settings())
-            print(f"settings saved to {path}", file=sys.stderr)
-        except (OSError, UserError) as error:  # a read-only config folder does not make the session fail
-            reason = getattr(error, "strerror", None) or str(error)
-            print(f"wgpuviewer: warning: settings not saved: {settings_path()} cannot be written ({reason}); "
-                  f"set {CONFIG_ENV} to a writable folder", file=sys.stderr)
+        save_session(viewer.current_settings())
     if code == 0 and scripted and viewer.problems:  # a scripted run reports what the HUD showed
         print(f"wgpuviewer: error: {viewer.problems[0]}", file=sys.stderr)
         return 2
