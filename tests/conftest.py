@@ -15,6 +15,7 @@ import tempfile
 from pathlib import Path
 
 import pytest
+import wgpu  # noqa: F401 - before logging.getLogger("wgpu") below: wgpu refuses a logger it did not create
 
 IN_CI = bool(os.environ.get("CI"))
 

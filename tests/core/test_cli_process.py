@@ -138,3 +138,40 @@ def test_warnings_print_as_one_line(capsys):
     err = capsys.readouterr().err.splitlines()
     assert err == ["maptools: warning: x.npy: 3 NaN/inf texels replaced (--nan-policy zero)",
                    "maptools: warning: second"]
+
+
+def test_long_builds_show_a_progress_bar_on_a_terminal(monkeypatch):
+    import io
+    import time
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    out = Terminal()
+    monkeypatch.setattr(sys, "stderr", out)
+    with core_cli.terminal_progress("maps for distance", delay=0.2) as progress:
+        progress("bricks.distance", 0, 2)
+        time.sleep(0.8)  # one long step: the bar appears after the delay and its clock runs
+        progress("bumps.distance", 1, 2)
+        progress("done", 2, 2)
+    text = out.getvalue()
+    assert "maps for distance" in text and "bricks.distance" in text and "1/2" in text, text
+    quiet = io.StringIO()  # not a terminal: no bar
+    monkeypatch.setattr(sys, "stderr", quiet)
+    with core_cli.terminal_progress("maps", delay=0) as progress:
+        progress("x", 0, 1)
+    assert quiet.getvalue() == ""
+
+
+def test_prepare_reports_each_texture_it_builds(gpu):
+    from wgpuviewer.relief.renderer import Renderer
+    from wgpuviewer.scene import default_scene_path, load_scene
+
+    renderer = Renderer(load_scene(default_scene_path()), gpu)
+    steps = []
+    todo = renderer.missing("normal")
+    renderer.prepare("normal", lambda label, done, total: steps.append((label, done, total)))
+    assert todo == [(m, k) for m in ("bricks", "bumps") for k in ("albedo", "normal")]
+    assert steps == [(f"{m}.{k}", i, 4) for i, (m, k) in enumerate(todo)] + [("done", 4, 4)]
+    assert renderer.missing("normal") == [] and renderer.missing("pom") == [("bricks", "depth"), ("bumps", "depth")]
