@@ -15,22 +15,24 @@ from wgpuviewer.core.io import atomic_open
 INPUT_EXTS = (".png", ".npy")
 
 
-def validate_height(height, what: str = "height map") -> np.ndarray:
-    """A finite float32 (H, W) array in [0, 1], C-contiguous; anything else is a UserError."""
+def validate_height(height, what: str = "height map", *, dtype=np.float32, error=UserError) -> np.ndarray:
+    """A finite (H, W) array in [0, 1] of ``dtype``, C-contiguous; anything else raises ``error`` (a UserError
+    here; the probe API raises InputError) naming ``what``."""
     a = np.asarray(height)
     if a.ndim != 2:
-        raise UserError(f"{what}: expected a 2-D (H, W) height map, got shape {a.shape}")
+        raise error(f"{what}: expected a 2-D (H, W) height map, got shape {a.shape}")
     if a.size == 0:
-        raise UserError(f"{what}: empty height map {a.shape}")
+        raise error(f"{what}: empty height map {a.shape}")
     if not (np.issubdtype(a.dtype, np.floating) or np.issubdtype(a.dtype, np.integer)) or a.dtype == bool:
-        raise UserError(f"{what}: unsupported dtype {a.dtype}; expected float heights in [0, 1]")
-    a = np.ascontiguousarray(a, dtype=np.float32)
+        raise error(f"{what}: unsupported dtype {a.dtype}; expected float heights in [0, 1]")
+    a = np.ascontiguousarray(a, dtype=dtype)
     bad = ~np.isfinite(a)
     if bad.any():
-        raise UserError(f"{what}: {int(bad.sum())} NaN/inf texel(s); fix the data or choose --nan-policy zero|nearest")
+        raise error(f"{what}: {int(bad.sum())} NaN/inf texel(s); clean the data "
+                    "(maptools: --nan-policy zero|nearest replaces them)")
     lo, hi = float(a.min()), float(a.max())
     if lo < 0.0 or hi > 1.0:
-        raise UserError(f"{what}: heights must lie in [0, 1], found [{lo:g}, {hi:g}]; rescale the data")
+        raise error(f"{what}: heights must lie in [0, 1] (1 = top), found [{lo:g}, {hi:g}]; rescale the data")
     return a
 
 

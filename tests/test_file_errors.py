@@ -12,24 +12,10 @@ import numpy as np
 import pytest
 
 from maptools import cli as maptools_cli
+from tests.relief.scenes import material_scene
 from wgpuviewer import cli, textures
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.scene import load_scene
-
-SCENE = """
-[scene]
-techniques = ["basic", "pom", "distance"]
-[camera]
-position = [0.0, 1.0, 2.0]
-target = [0.0, 0.0, 0.0]
-[materials.m]
-albedo = "{albedo}"
-height = "{height}"
-[[objects]]
-type = "plane"
-material = "m"
-size = [2.0, 2.0]
-"""
 
 
 @pytest.fixture(autouse=True)
@@ -57,7 +43,7 @@ def files(tmp_path):
 
 def scene_file(folder, albedo="good.png", height="good.png", name="s.toml"):
     path = folder / name
-    path.write_text(SCENE.format(albedo=albedo, height=height))
+    path.write_text(material_scene(["basic", "pom", "distance"], f'albedo = "{albedo}"\nheight = "{height}"'))
     return path
 
 

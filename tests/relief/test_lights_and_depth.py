@@ -6,25 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.relief.scenes import material_scene
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.scene import MAX_LIGHTS, parse_scene
 
-BASE = """
-[scene]
-techniques = ["basic", "pom"]
-[camera]
-position = [0.0, 1.2, 2.0]
-target = [0.0, 0.0, 0.0]
-near = {near}
-far = 50.0
-[materials.m]
-albedo = [0.6, 0.6, 0.6]
-height = "builtin:bumps"
-[[objects]]
-type = "plane"
-material = "m"
-size = [2.0, 2.0]
+BOX = """
 [[objects]]
 type = "box"
 material = "m"
@@ -49,7 +36,9 @@ intensity = 2.0
 
 
 def scene(lights: str, near: float = 0.05):
-    return parse_scene(BASE.format(near=near) + lights)
+    return parse_scene(material_scene(["basic", "pom"], 'albedo = [0.6, 0.6, 0.6]\nheight = "builtin:bumps"',
+                                      position=(0.0, 1.2, 2.0), camera=f"near = {near}\nfar = 50.0",
+                                      extra=BOX + lights))
 
 
 @pytest.mark.requires_gpu

@@ -13,21 +13,10 @@ import cv2
 import numpy as np
 import pytest
 
-SCENE = """
-[scene]
-techniques = ["basic", "normal", "pom"]
-[camera]
-position = [0.0, 1.0, 1.6]
-target = [0.0, 0.0, 0.0]
-[materials.m]
-albedo = "good.png"
-normal = "normal.png"
-height = "corrupt.png"
-[[objects]]
-type = "plane"
-material = "m"
-size = [2.0, 2.0]
-"""
+from tests.relief.scenes import material_scene
+
+SCENE = material_scene(["basic", "normal", "pom"], 'albedo = "good.png"\nnormal = "normal.png"\nheight = "corrupt.png"',
+                       position=(0.0, 1.0, 1.6))
 
 
 @pytest.fixture(scope="module")

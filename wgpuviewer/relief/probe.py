@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import wgpu
 
+from maptools import validate_height
 from wgpuviewer.core.errors import InputError
 from wgpuviewer.core.gpu import Gpu, get_gpu
 
@@ -104,7 +105,7 @@ def probe(
         names = ", ".join(name for name, t in TECHNIQUES.items() if t.ray_search)
         raise InputError(f"probe: technique {technique!r} does not trace rays; ray-search techniques: {names}")
     values = resolve_params(tech, params)
-    height = _check_height(height)
+    height = validate_height(height, "probe: height", dtype=np.float64, error=InputError)
     if address not in ("repeat", "clamp"):
         raise InputError(f"probe: address = {address!r}; expected 'repeat' or 'clamp'")
     scale = _check_height_scale(height_scale)
@@ -129,20 +130,6 @@ def probe(
     hits.uv = hits.uv + offset
     hits.capped |= far | ~np.isfinite(hits.uv).all(axis=1) | ~np.isfinite(hits.depth)
     return hits
-
-
-def _check_height(height) -> np.ndarray:
-    """A non-empty 2D array of finite heights in [0, 1], float64 (as exact_hit's depth check)."""
-    h = np.asarray(height, np.float64)
-    if h.ndim != 2 or h.size == 0:
-        raise InputError(f"probe: height must be a non-empty 2D array (rows, cols), got shape {np.shape(height)}")
-    bad = ~np.isfinite(h)
-    if bad.any():
-        raise InputError(f"probe: height contains {int(bad.sum())} NaN/inf value(s); clean the data first")
-    lo, hi = float(h.min()), float(h.max())
-    if lo < 0.0 or hi > 1.0:
-        raise InputError(f"probe: height values must lie in [0, 1] (1 = top), got [{lo:g}, {hi:g}]")
-    return h
 
 
 def _check_height_scale(height_scale) -> float:
