@@ -130,3 +130,11 @@ def test_a_batch_goes_on_past_bad_inputs_and_reports_each(files, capsys):
                          ("corrupt.png", "cannot decode image")):
         assert "FAILED" in rows[name] and reason in rows[name], rows[name]
     assert "1 generated, 0 up to date, 3 failed" in out
+
+
+def test_maptools_refuses_a_huge_declared_size_at_once(tmp_path, capsys):
+    from tests.core.test_images import huge_npy
+
+    src = huge_npy(tmp_path / "huge.npy")
+    assert maptools_cli.main(["generate", "normal", str(src), "-o", str(tmp_path / "n.png"), "--backend", "cpu"]) == 2
+    assert one_line(capsys, "maptools").startswith(f"maptools: error: {src}: 60000x60000 is larger than the limit")

@@ -175,3 +175,17 @@ def test_prepare_reports_each_texture_it_builds(gpu):
     assert todo == [(m, k) for m in ("bricks", "bumps") for k in ("albedo", "normal")]
     assert steps == [(f"{m}.{k}", i, 4) for i, (m, k) in enumerate(todo)] + [("done", 4, 4)]
     assert renderer.missing("normal") == [] and renderer.missing("pom") == [("bricks", "depth"), ("bumps", "depth")]
+
+
+def test_opencv_warnings_are_silenced(tmp_path):
+    """Before cv2 is imported (the variable) and after (its log level): no `[ WARN:0@...]` lines."""
+    for order in ("prepare, then import", "import, then prepare"):
+        steps = ["from wgpuviewer.core.cli import prepare_process", "prepare_process('maptools')", "import cv2"]
+        if order.startswith("import"):
+            steps = [steps[2], steps[0], steps[1]]
+        code = "; ".join([*steps, "cv2.imread('missing.png')", "print('read')"])
+        env = {k: v for k, v in os.environ.items() if k != "OPENCV_LOG_LEVEL"}
+        result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, env=env,
+                                cwd=tmp_path)
+        assert result.stdout.strip() == "read", result.stderr
+        assert "WARN" not in result.stderr, (order, result.stderr)
