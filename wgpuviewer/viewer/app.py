@@ -249,11 +249,12 @@ class Viewer:
         self.build = None
         if build.error:
             self.problem(build.error)
+            if self.wanted.get(build.side) == build.technique:  # not asked for again until a key asks
+                self.wanted[build.side] = self.technique_b if build.side == "B" else self.technique
         elif self.wanted.get(build.side) == build.technique:
             self._show(build.side, build.technique)
         for side, name in self.wanted.items():
-            if self.build is None and name not in (self.technique, self.technique_b) and not self.ready(name) \
-                    and not (build.error and name == build.technique):
+            if self.build is None and not self.ready(name):
                 self.build = MapBuild(self.renderer, name, side)
 
     def problem(self, text: str):
