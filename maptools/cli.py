@@ -1,6 +1,7 @@
 """``maptools`` command line: generate one map, batch-generate many, or check GPU against CPU.
 
-Exit codes: 0 success, 1 a batch job or a check failed, 2 a user error (one line on stderr).
+Exit codes: 0 success, 1 a batch job or a check failed, 2 a user error (one line on stderr), 3 an internal error
+(one line; the traceback is saved to a file whose path it prints; a batch goes on past it and reports it).
 """
 
 from __future__ import annotations
@@ -15,9 +16,10 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from wgpuviewer.core.cli import OneLineParser, prepare_process, run_command, save_traceback
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.images import HEIGHT_CHANNELS, NAN_POLICIES, read_height
-from wgpuviewer.core.io import atomic_open, remove_stale_temps
+from wgpuviewer.core.io import atomic_open, output_dir, refuse_directory, remove_stale_temps
 
 from . import VERSION, generate, resolve_backend
 from .io import INPUT_EXTS, write_result
@@ -41,9 +43,13 @@ def _add_backend(p: argparse.ArgumentParser) -> None:
 
 
 def _parse_kinds(text: str | None) -> list[str]:
-    if not text:
+    """--kinds: None (not given) means every kind; a given list must name at least one."""
+    if text is None:
         return list(KINDS)
     names = [t.strip() for t in text.split(",") if t.strip()]
+    if not names:
+        raise UserError(f"--kinds {text!r}: expected a comma-separated list of kinds, e.g. normal,maxmip "
+                        "(omit --kinds for all)")
     for n in names:
         get_kind(n)
     return list(dict.fromkeys(names))
@@ -63,7 +69,7 @@ def _parse_sets(items: list[str] | None) -> dict[str, dict]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="maptools", description="Generate maps derived from height maps.")
+    parser = OneLineParser(prog="maptools", description="Generate maps derived from height maps.")
     sub = parser.add_subparsers(dest="command", required=True)
 
     gen = sub.add_parser("generate", help="generate one map from one height map")
@@ -101,6 +107,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     sub.add_parser("kinds", help="list the map kinds and their options")
 
+    cac = sub.add_parser("cache", help="the renderer's map cache: where it is, how big, and emptying it")
+    cac_actions = cac.add_subparsers(dest="action", required=True, metavar="ACTION")
+    cac_actions.add_parser("info", help="location, size cap, maps per kind")
+    cln = cac_actions.add_parser("clean", help="remove cached maps (all, or those unused for a while)")
+    cln.add_argument("--older-than", metavar="AGE", help="only maps not used for AGE, e.g. 30m, 12h, 7d, 2w")
+
     ben = sub.add_parser("bench", help="GPU vs CPU time per kind and size, side by side (one run, same machine)")
     ben.add_argument("--kinds", default=None, help="comma-separated kinds (default all)")
     ben.add_argument("--sizes", default="64,256,1024", help="square sizes for the 2D kinds")
@@ -118,6 +130,7 @@ def cmd_generate(args) -> int:
     opts = {o.name: getattr(args, f"opt_{o.name}") for o in kind.options if getattr(args, f"opt_{o.name}") is not None}
     opts = kind.resolve(opts)
     out = Path(args.output)
+    refuse_directory(out, f"{Path(args.input).stem}.{kind.name}{kind.extensions[0]}")
     if out.suffix.lower() not in kind.extensions:
         raise UserError(f"{out}: {kind.name} maps are written as {', '.join(kind.extensions)}")
     height = read_height(args.input, args.channel, args.nan_policy)
@@ -129,13 +142,39 @@ def cmd_generate(args) -> int:
 
 # -- batch ------------------------------------------------------------------------------------------
 
-def collect_inputs(paths: list[str]) -> tuple[list[Path], list[tuple[str, str]]]:
-    """Sorted, de-duplicated input files (folders searched recursively for .png/.npy) and missing paths."""
+def _output_name(f: Path) -> bool:
+    """Named like a batch output: STEM.KIND.EXT for a known kind and one of its extensions."""
+    stem, _, kind = f.stem.rpartition(".")
+    return bool(stem) and kind in KINDS and f.suffix.lower() in KINDS[kind].extensions
+
+
+def is_output(f: Path, folder: Path, outdir: Path | None) -> bool:
+    """A map this tool wrote, found while searching input ``folder``: it has a batch sidecar (``NAME.json``
+    written by maptools), or it lies in the output folder and is named like an output, or the output folder lies inside
+    ``folder`` (then nothing in it is an input)."""
+    try:
+        if str(json.loads(sidecar(f).read_text()).get("version", "")).startswith("maptools-"):
+            return True
+    except (OSError, ValueError, TypeError, AttributeError):
+        pass
+    if outdir is None:
+        return False
+    out, here = outdir.resolve(), f.resolve()
+    if not here.is_relative_to(out):
+        return False
+    return _output_name(f) or out != folder.resolve()
+
+
+def collect_inputs(paths: list[str], outdir: Path | None = None) -> tuple[list[Path], list[tuple[str, str]]]:
+    """Sorted, de-duplicated input files (folders searched recursively for .png/.npy) and missing paths.
+    Outputs are never inputs (``is_output``): a folder's search leaves them out; a file given by name is
+    taken as given."""
     files: set[Path] = set()
     missing = []
     for p in map(Path, paths):
         if p.is_dir():
-            files.update(f for f in p.rglob("*") if f.is_file() and f.suffix.lower() in INPUT_EXTS)
+            files.update(f for f in p.rglob("*") if f.is_file() and f.suffix.lower() in INPUT_EXTS
+                         and not is_output(f, p, outdir))
         elif p.is_file():
             files.add(p)
         else:
@@ -184,12 +223,9 @@ def cmd_batch(args) -> int:
     si, sn = parse_shard(args.shard)
     if args.jobs < 1:
         raise UserError(f"--jobs {args.jobs}: must be >= 1")
-    files, missing = collect_inputs(args.inputs)
+    outdir = output_dir(args.output, "-o")
+    files, missing = collect_inputs(args.inputs, outdir)
     files = shard(files, si, sn)
-    outdir = Path(args.output)
-    if outdir.exists() and not outdir.is_dir():
-        raise UserError(f"-o {outdir}: exists and is not a folder")
-    outdir.mkdir(parents=True, exist_ok=True)
     backend = resolve_backend(args.backend) if files else "cpu"
 
     rows: list[tuple[str, str, str, str]] = [(p, "-", "FAILED", msg) for p, msg in missing]
@@ -240,8 +276,10 @@ def cmd_batch(args) -> int:
                 res.append((str(f), k, "ok", f"{out.name} ({time.perf_counter() - t0:.2f} s, {backend})"))
             except UserError as exc:
                 res.append((str(f), k, "FAILED", str(exc)))
-            except Exception as exc:  # noqa: BLE001 - report, keep going with the other jobs
-                res.append((str(f), k, "FAILED", f"{type(exc).__name__}: {exc}"))
+            except Exception as exc:  # noqa: BLE001 - a bug: report it, keep going with the other jobs
+                saved = save_traceback("maptools", exc)
+                res.append((str(f), k, "INTERNAL", f"{type(exc).__name__}: {exc} (a bug; traceback "
+                                                   f"{f'saved to {saved}' if saved else 'not saved'})"))
             finally:
                 if bar is not None:
                     with lock:
@@ -261,12 +299,14 @@ def cmd_batch(args) -> int:
         rows.extend(r)
 
     print_table(rows)
-    failed = sum(r[2] == "FAILED" for r in rows)
+    failed = sum(r[2] in ("FAILED", "INTERNAL") for r in rows)
+    internal = sum(r[2] == "INTERNAL" for r in rows)
     done = sum(r[2] == "ok" for r in rows)
     skipped = sum(r[2] == "skipped" for r in rows)
     print(f"{done} generated, {skipped} up to date, {failed} failed"
+          + (f" ({internal} internal error(s): please report them)" if internal else "")
           + (f" (shard {si}/{sn}: {len(files)} input(s))" if sn > 1 else ""))
-    return 1 if failed else 0
+    return 3 if internal else 1 if failed else 0
 
 
 def print_table(rows) -> None:
@@ -354,6 +394,33 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def parse_age(text: str) -> float:
+    """'30s', '15m', '12h', '7d', '2w' -> seconds."""
+    units = {"s": 1, "m": 60, "h": 3600, "d": 86400, "w": 7 * 86400}
+    number, unit = text.strip()[:-1], text.strip()[-1:].lower()
+    try:
+        value = float(number)
+    except ValueError:
+        value = -1.0
+    if unit not in units or not value >= 0:
+        raise UserError(f"--older-than {text!r}: expected an age such as 30m, 12h, 7d or 2w")
+    return value * units[unit]
+
+
+def cmd_cache(args) -> int:
+    from . import cache
+
+    if args.action == "info":
+        print(cache.describe())
+        return 0
+    age = parse_age(args.older_than) if args.older_than else None
+    removed = cache.clean(age)
+    freed = sum(e.size for e in removed) / 2**20
+    print(f"removed {len(removed)} maps ({freed:.1f} MiB) from {cache.cache_dir()}"
+          + (f" not used for {args.older_than}" if age is not None else ""))
+    return 0
+
+
 def cmd_kinds(args) -> int:
     for kind in KINDS.values():
         print(f"{kind.name}: {kind.description}")
@@ -364,17 +431,15 @@ def cmd_kinds(args) -> int:
 
 
 def main(argv=None) -> int:
-    parser = build_parser()
+    """Exit codes (wgpuviewer.core.cli): 0 ok, 1 a batch job or check failed, 2 a user error, 3 an internal error."""
+    prepare_process("maptools")  # before any GPU driver loads
     try:
-        args = parser.parse_args(argv)
-    except SystemExit as exc:  # argparse: usage errors (2) and --help (0)
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # argparse: usage errors (2, one line) and --help (0)
         return int(exc.code or 0)
-    try:
-        return {"generate": cmd_generate, "batch": cmd_batch, "check": cmd_check, "kinds": cmd_kinds,
-                "bench": cmd_bench}[args.command](args)
-    except UserError as exc:
-        print(f"maptools: error: {exc}", file=sys.stderr)
-        return 2
+    commands = {"generate": cmd_generate, "batch": cmd_batch, "check": cmd_check, "kinds": cmd_kinds,
+                "bench": cmd_bench, "cache": cmd_cache}
+    return run_command("maptools", lambda: commands[args.command](args))
 
 
 if __name__ == "__main__":  # pragma: no cover

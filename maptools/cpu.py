@@ -39,10 +39,19 @@ def normal(height: np.ndarray, *, strength: float = 1.0, y: str = "opengl", bord
     gx, gy = sobel(height, 3, border)
     ysign = np.float32(1.0 if y == "opengl" else -1.0)
     s = np.float32(strength)
-    n = np.stack([-s * gx * np.float32(0.125), ysign * s * gy * np.float32(0.125),
-                  np.ones_like(gx)], axis=-1)
-    n /= np.sqrt((n * n).sum(axis=-1, keepdims=True))
-    return n.astype(np.float32)
+    # Filled and normalised component by component: temporaries are one channel, not three (large maps).
+    n = np.empty(gx.shape + (3,), np.float32)
+    n[..., 0] = -s * gx * np.float32(0.125)
+    del gx
+    n[..., 1] = ysign * s * gy * np.float32(0.125)
+    del gy
+    n[..., 2] = 1.0
+    length = n[..., 0] * n[..., 0]  # summed in the order of a reduction over the last axis
+    length += n[..., 1] * n[..., 1]
+    length += n[..., 2] * n[..., 2]
+    np.sqrt(length, out=length)
+    n /= length[..., None]
+    return n
 
 
 def dilation_radius(kernel: int, iterations: int) -> int:
@@ -59,9 +68,12 @@ def complexity(height: np.ndarray, *, ksize: int = 3, dilate_kernel: int = 3, it
     border="repeat" wraps both the Sobel and the dilation (tiling textures).
     """
     gx, gy = sobel(height, ksize, border)
-    mag = np.sqrt(gx ** 2 + gy ** 2)
+    mag = np.square(gx, out=gx)  # in place: the same values as sqrt(gx ** 2 + gy ** 2), fewer temporaries
+    mag += np.square(gy, out=gy)
+    del gy
+    np.sqrt(mag, out=mag)
     mx = np.max(mag)
-    c = np.zeros_like(mag) if not mx > 0 else np.clip(mag / mx, 0, 1)
+    c = np.zeros_like(mag) if not mx > 0 else np.clip(np.divide(mag, mx, out=mag), 0, 1, out=mag)
     kernel = np.ones((dilate_kernel, dilate_kernel), np.uint8)
     if border == "repeat":
         r = dilation_radius(dilate_kernel, iterations)

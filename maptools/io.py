@@ -15,30 +15,33 @@ from wgpuviewer.core.io import atomic_open
 INPUT_EXTS = (".png", ".npy")
 
 
-def validate_height(height, what: str = "height map") -> np.ndarray:
-    """A finite float32 (H, W) array in [0, 1], C-contiguous; anything else is a UserError."""
+def validate_height(height, what: str = "height map", *, dtype=np.float32, error=UserError) -> np.ndarray:
+    """A finite (H, W) array in [0, 1] of ``dtype``, C-contiguous; anything else raises ``error`` (a UserError
+    here; the probe API raises InputError) naming ``what``."""
     a = np.asarray(height)
     if a.ndim != 2:
-        raise UserError(f"{what}: expected a 2-D (H, W) height map, got shape {a.shape}")
+        raise error(f"{what}: expected a 2-D (H, W) height map, got shape {a.shape}")
     if a.size == 0:
-        raise UserError(f"{what}: empty height map {a.shape}")
+        raise error(f"{what}: empty height map {a.shape}")
     if not (np.issubdtype(a.dtype, np.floating) or np.issubdtype(a.dtype, np.integer)) or a.dtype == bool:
-        raise UserError(f"{what}: unsupported dtype {a.dtype}; expected float heights in [0, 1]")
-    a = np.ascontiguousarray(a, dtype=np.float32)
+        raise error(f"{what}: unsupported dtype {a.dtype}; expected float heights in [0, 1]")
+    a = np.ascontiguousarray(a, dtype=dtype)
     bad = ~np.isfinite(a)
     if bad.any():
-        raise UserError(f"{what}: {int(bad.sum())} NaN/inf texel(s); fix the data or choose --nan-policy zero|nearest")
+        raise error(f"{what}: {int(bad.sum())} NaN/inf texel(s); clean the data "
+                    "(maptools: --nan-policy zero|nearest replaces them)")
     lo, hi = float(a.min()), float(a.max())
     if lo < 0.0 or hi > 1.0:
-        raise UserError(f"{what}: heights must lie in [0, 1], found [{lo:g}, {hi:g}]; rescale the data")
+        raise error(f"{what}: heights must lie in [0, 1] (1 = top), found [{lo:g}, {hi:g}]; rescale the data")
     return a
 
 
-def _png_bytes(img: np.ndarray) -> bytes:
+def _png_bytes(img: np.ndarray) -> np.ndarray:
+    """The encoded PNG (a uint8 array: file objects write it without a copy)."""
     ok, buf = cv2.imencode(".png", img)
     if not ok:
         raise UserError("could not encode PNG")
-    return buf.tobytes()
+    return buf
 
 
 def _bits_check(bits: int) -> None:
@@ -53,9 +56,13 @@ def write_normal(f, n: np.ndarray, ext: str, bits: int = 8) -> None:
         return
     _bits_check(bits)
     top = 255 if bits == 8 else 65535
-    rgb = np.clip(np.rint((np.asarray(n, np.float64) + 1.0) * 0.5 * top), 0, top)
-    rgb = rgb.astype(np.uint8 if bits == 8 else np.uint16)
-    f.write(_png_bytes(np.ascontiguousarray(rgb[:, :, ::-1])))  # OpenCV writes BGR
+    n = np.asarray(n)
+    bgr = np.empty(n.shape, np.uint8 if bits == 8 else np.uint16)  # OpenCV writes BGR
+    step = max(1, (1 << 16) // max(n.shape[1], 1))  # float64 in row bands: small temporaries at any size
+    for row in range(0, n.shape[0], step):
+        band = np.asarray(n[row:row + step], np.float64)
+        bgr[row:row + step] = np.clip(np.rint((band + 1.0) * 0.5 * top), 0, top)[:, :, ::-1]
+    f.write(_png_bytes(bgr))
 
 
 def write_complexity(f, c: np.ndarray, ext: str, bits: int = 8) -> None:

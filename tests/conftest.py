@@ -11,9 +11,11 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
+import wgpu  # noqa: F401 - before logging.getLogger("wgpu") below: wgpu refuses a logger it did not create
 
 IN_CI = bool(os.environ.get("CI"))
 
@@ -37,13 +39,17 @@ ROOT = Path(__file__).resolve().parent.parent
 
 @pytest.fixture(scope="session", autouse=True)
 def isolated_user_dirs(tmp_path_factory):
-    """Tests never touch the user's settings or map cache. Generated maps go to a cache of the test
+    """Tests never touch the user's settings, map cache or temp folder. Generated maps go to a cache of the test
     suite's own, kept between runs (building 3D maps is slow on a software adapter); subprocesses
-    inherit both variables."""
-    saved = {name: os.environ.get(name) for name in ("WGPUVIEWER_CACHE_DIR", "WGPUVIEWER_CONFIG_DIR")}
+    inherit the variables."""
+    saved = {name: os.environ.get(name) for name in ("WGPUVIEWER_CACHE_DIR", "WGPUVIEWER_CONFIG_DIR", "TMPDIR")}
     os.environ["WGPUVIEWER_CACHE_DIR"] = str(ROOT / ".pytest_cache" / "map-cache")
     os.environ["WGPUVIEWER_CONFIG_DIR"] = str(tmp_path_factory.mktemp("config"))
+    # Temp files the code makes (saved tracebacks of internal errors, ...) stay in the test session's folder.
+    saved_tempdir = tempfile.tempdir
+    os.environ["TMPDIR"] = tempfile.tempdir = str(tmp_path_factory.mktemp("tmp"))
     yield
+    tempfile.tempdir = saved_tempdir
     for name, value in saved.items():
         if value is None:
             os.environ.pop(name, None)

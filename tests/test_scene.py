@@ -296,7 +296,7 @@ def test_missing_file(tmp_path):
 
 def test_texture_path_is_a_folder(tmp_path):
     (tmp_path / "maps").mkdir()
-    error(tmp_path, scene_text(material=MATERIAL + "height = 'maps'\n"), "materials.rock.height = 'maps'", "not a file")
+    error(tmp_path, scene_text(material=MATERIAL + "height = 'maps'\n"), "materials.rock.height = 'maps'", "is a directory")
 
 
 @pytest.mark.parametrize("value,shown", [("'builtin:brick'", "'builtin:brick'"), ("{ builtin = 'brick' }", "'brick'")])

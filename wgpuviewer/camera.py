@@ -29,12 +29,15 @@ def look_at(eye, target, up) -> np.ndarray:
 
 
 def perspective(fov_y_deg: float, aspect: float, near: float, far: float) -> np.ndarray:
+    """Reversed-Z projection: depth 1 at ``near``, 0 at ``far`` (the renderer clears depth to 0 and keeps the
+    greater). Depth is then about near / distance, which float32 holds with the same relative precision at any
+    distance, so a tiny ``near`` (1e-9) still separates surfaces (standard depth would round to 1 everywhere)."""
     f = 1.0 / np.tan(np.radians(fov_y_deg) / 2.0)
     m = np.zeros((4, 4))
     m[0, 0] = f / aspect
     m[1, 1] = f
-    m[2, 2] = far / (near - far)
-    m[2, 3] = near * far / (near - far)
+    m[2, 2] = near / (far - near)
+    m[2, 3] = near * far / (far - near)
     m[3, 2] = -1.0
     return m
 

@@ -8,11 +8,13 @@ import os
 import sys
 from pathlib import Path
 
+from wgpuviewer.core.cli import OneLineParser, prepare_process, run_command, terminal_progress
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.gpu import BACKEND_CHOICES, BACKEND_ENV
-from wgpuviewer.relief.output import OUTPUT_MODES
+from wgpuviewer.core.io import output_dir, refuse_directory
 
 DEFAULT_SIZE = (1280, 720)
+MATERIAL_HELP = ("a material folder (ambientCG, Poly Haven or albedo/normal/height names) shown on the scene's "
+                 "first plane; without SCENE, the default scene's")
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -43,48 +45,68 @@ def has_display() -> bool:
     return True
 
 
-def cmd_render(args) -> int:
+def render_to(out: Path, scene, technique: str, size: tuple[int, int], mode: str, backend: str | None) -> None:
+    """Render ``scene`` offscreen into ``out`` (.png or .npy), the maps it needs built first with a progress bar."""
     from wgpuviewer.core.gpu import get_gpu
-    from wgpuviewer.relief.output import OUTPUT_SUFFIXES, save_output
+    from wgpuviewer.relief.output import save_output
     from wgpuviewer.relief.renderer import Renderer
 
+    renderer = Renderer(scene, get_gpu(backend))
+    with terminal_progress(f"maps for {technique}") as progress:
+        renderer.prepare(technique, progress)
+    save_output(out, renderer.render(technique, size), mode)
+
+
+def cmd_render(args) -> int:
+    from wgpuviewer.relief.output import OUTPUT_SUFFIXES
+
     out = Path(args.output)
+    refuse_directory(out, "render.png")
     if out.suffix.lower() not in OUTPUT_SUFFIXES:
         raise UserError(f"-o {out}: unknown output type {out.suffix!r}; use .png (image) or .npy (raw float32 data)")
-    scene = load_scene_arg(args.scene)
+    scene = scene_from_args(args)
     technique = pick_technique(scene, args.technique)
-    size = parse_size(args.size) if args.size else DEFAULT_SIZE
-    renderer = Renderer(scene, get_gpu(args.backend))
-    save_output(out, renderer.render(technique, size), args.mode)
+    render_to(out, scene, technique, parse_size(args.size) if args.size else DEFAULT_SIZE, args.mode, args.backend)
     print(out)
     return 0
+
+
+def scene_from_args(args, fallback: str | None = None):
+    """The scene of ``args.scene`` (default: the built-in one, or ``fallback``), with ``--material DIR`` shown on
+    its first plane."""
+    from .scene import with_folder_material
+
+    scene = load_scene_arg(args.scene or fallback)
+    return with_folder_material(scene, Path(args.material)) if args.material else scene
 
 
 def cmd_view(args) -> int:
     from wgpuviewer.viewer.settings import load_settings
 
-    scripted = args.frames is not None or bool(args.screenshot)
+    scripted = args.frames is not None or bool(args.screenshot) or bool(args.keys)
     settings, _warnings = load_settings()  # corrupt/outdated file: defaults + a warning on stderr
-    scene_arg, technique_arg = args.scene, args.technique
+    technique_arg = args.technique
     window = has_display()
-    if window and not scripted and scene_arg is None and settings.last_scene and Path(settings.last_scene).is_file():
-        scene_arg = settings.last_scene  # interactive runs continue where the last one ended
-        print(f"opening the last scene {scene_arg} (give a SCENE to open another)", file=sys.stderr)
-    scene = load_scene_arg(scene_arg)
-    if window and not scripted and technique_arg is None and scene_arg == settings.last_scene \
-            and settings.last_technique in scene.techniques:
+    last = settings.last_scene if window and not scripted and args.scene is None and not args.material else ""
+    scene = None
+    if last:  # interactive runs continue where the last one ended
+        try:
+            scene = scene_from_args(args, last)
+            print(f"opening the last scene {last} (give a SCENE to open another)", file=sys.stderr)
+        except UserError as error:
+            print(f"wgpuviewer: warning: the last scene cannot be opened ({error}); opening the default scene",
+                  file=sys.stderr)
+            last = ""
+    if scene is None:
+        scene = scene_from_args(args)
+    if last and technique_arg is None and settings.last_technique in scene.techniques:
         technique_arg = settings.last_technique
     technique = pick_technique(scene, technique_arg)
     size = parse_size(args.size) if args.size else None
     if not window:
-        from wgpuviewer.core.gpu import get_gpu
-        from wgpuviewer.relief.output import save_output
-        from wgpuviewer.relief.renderer import Renderer
-
         out = Path("out") / f"{Path(scene.path).stem if scene.path else 'scene'}_{technique}.png"
         print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the scene to {out} instead")
-        renderer = Renderer(scene, get_gpu(args.backend))
-        save_output(out, renderer.render(technique, size or DEFAULT_SIZE), "color")
+        render_to(out, scene, technique, size or DEFAULT_SIZE, "color", args.backend)
         print(out)
         return 0
     from wgpuviewer.viewer.app import run_viewer
@@ -165,7 +187,7 @@ def cmd_bench(args) -> int:
     options = resolve_options(args.suite, resolution=resolution, heightmaps=names(args.heightmaps, "--heightmaps"),
                               techniques=names(args.techniques, "--techniques"), angles=angles, frames=args.frames,
                               backend=args.backend, command=command)
-    out = Path(args.out)
+    out = output_dir(args.out, "--out")  # before a long run, not after it
     if args.from_csv:
         from wgpuviewer.bench.run import rereport
 
@@ -187,7 +209,10 @@ def cmd_info(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    from wgpuviewer.core.gpu import BACKEND_CHOICES, BACKEND_ENV
+    from wgpuviewer.relief.output import OUTPUT_MODES
+
+    parser = OneLineParser(
         prog="wgpuviewer", description="Relief-mapping techniques on WebGPU: viewer, offscreen renderer, probe."
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -203,6 +228,7 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("--gui", choices=("glfw", "qt", "auto"), default="glfw",
                       help="window toolkit through rendercanvas (default glfw; qt needs PySide6/PyQt6)")
     view.add_argument("--size", help="window size WIDTHxHEIGHT in logical pixels (default: the saved size, 1280x720)")
+    view.add_argument("--material", metavar="DIR", help=MATERIAL_HELP)
     view.set_defaults(func=cmd_view)
 
     render = sub.add_parser("render", help="render a scene offscreen to PNG or .npy")
@@ -212,6 +238,7 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--size", help=f"WIDTHxHEIGHT (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
     render.add_argument("--mode", choices=OUTPUT_MODES, default="color", help="what to write")
     render.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    render.add_argument("--material", metavar="DIR", help=MATERIAL_HELP)
     render.set_defaults(func=cmd_render)
 
     techniques = sub.add_parser("techniques", help="list techniques, their keys, needed maps and parameters")
@@ -250,15 +277,17 @@ COMMANDS = ("view", "render", "techniques", "accuracy", "bench", "info")
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    """Exit codes (wgpuviewer.core.cli): 0 ok, 1 a check failed, 2 a user error, 3 an internal error."""
+    prepare_process("wgpuviewer")  # before any GPU driver loads
     argv = list(sys.argv[1:] if argv is None else argv)
     if not argv or (argv[0] not in COMMANDS and argv[0] not in ("-h", "--help")):
         argv = ["view", *argv]  # `wgpuviewer [SCENE] [--technique ...]` means view
-    args = parser.parse_args(argv)
-    try:
+
+    def command() -> int:
+        args = build_parser().parse_args(argv)
         return args.func(args)
-    except UserError as error:
-        print(f"wgpuviewer: error: {error}", file=sys.stderr)
-        return error.exit_code
-    except KeyboardInterrupt:
-        return 130
+
+    try:
+        return run_command("wgpuviewer", command)
+    except SystemExit as exit_:  # argparse: --help (0) and usage errors (2, one line)
+        return int(exit_.code or 0)

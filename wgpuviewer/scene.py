@@ -14,10 +14,11 @@ from dataclasses import dataclass, replace
 from importlib.resources import files
 from pathlib import Path
 
-from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.errors import FileError, UserError
+from wgpuviewer.core.images import read_header
 from wgpuviewer.relief.techniques import TECHNIQUES, get_technique, resolve_params
 
-from .textures import BUILTINS, MAX_BUILTIN_SIZE, TextureRef
+from .textures import BUILTINS, MAX_BUILTIN_SIZE, TextureRef, find_material_files
 
 Vec3 = tuple[float, float, float]
 
@@ -98,6 +99,11 @@ class Scene:
 
 
 OBJECT_SIZES = {"plane": 2, "quad": 2, "box": 3}
+#: Most [[lights]] a scene may have: the renderer's Frame uniform holds them all (32 bytes each), and the
+#: shader loops over the scene's count only.
+MAX_LIGHTS = 256
+#: camera.far / camera.near at most: reversed-Z float depth separates surfaces over this range.
+MAX_DEPTH_RANGE = 1e12
 CHANNELS = ("auto", "r", "g", "b", "a")
 _MISSING = object()
 
@@ -221,13 +227,15 @@ _TEXTURE_FORMS = "'builtin:NAME', { builtin = NAME, size = [W, H] } or a file pa
 
 
 def _texture(t: _Table, name: str, base: Path, color_ok: bool = False, required: bool = False) -> TextureRef | None:
-    """A texture value (builtin, file or, where ``color_ok``, an RGB array); None when absent."""
+    """A texture value (builtin, file or, where ``color_ok``, an RGB array); None when absent. A file's header is
+    read here (format, size, limits: cheap), so a bad file is reported at once against its key."""
     expected = _TEXTURE_FORMS + (" or an RGB array [r, g, b]" if color_ok else "")
     value = t.get(name, _MISSING if required else None, f"a texture: {expected}")
     if value is None:
         return None
+    origin = f"{t.src}: {t.path(name)} = {_show(value)}"
     if isinstance(value, list) and color_ok:
-        return TextureRef("color", color=t.vector(name, 3, lo=0, hi=1))
+        return TextureRef("color", color=t.vector(name, 3, lo=0, hi=1), origin=origin)
     if isinstance(value, dict):
         spec = _Table(t.src, t.path(name), value, ("builtin", "size"))
         builtin = spec.string("builtin")
@@ -236,24 +244,30 @@ def _texture(t: _Table, name: str, base: Path, color_ok: bool = False, required:
                 and all(isinstance(s, int) and not isinstance(s, bool) and 1 <= s <= MAX_BUILTIN_SIZE
                         for s in size)):
             raise spec.error("size", size, f"expected [width, height], integers 1 to {MAX_BUILTIN_SIZE}")
-        return _builtin_ref(spec, "builtin", builtin, tuple(size))
+        return _builtin_ref(spec, "builtin", builtin, tuple(size), origin)
     if not isinstance(value, str):
         raise t.error(name, value, f"expected a texture: {expected}")
     if value.startswith("builtin:"):
-        return _builtin_ref(t, name, value, (256, 256))
-    path = (base / Path(value).expanduser()).resolve()  # base is ignored for absolute paths
+        return _builtin_ref(t, name, value, (256, 256), origin)
+    return _file_ref(t, name, value, (base / Path(value).expanduser()).resolve())  # base is ignored for absolute
+
+
+def _file_ref(t: _Table, name: str, value, path: Path) -> TextureRef:
+    """A file texture at ``path`` named by key ``name`` (value ``value``), its header checked."""
     if not path.exists():
         raise t.error(name, value, f"file not found (looked for {path})")
-    if not path.is_file():
-        raise t.error(name, value, f"not a file ({path}); expected an image or .npy file")
-    return TextureRef("file", path=path)
+    try:
+        read_header(path)
+    except FileError as error:
+        raise t.error(name, value, error.reason) from None
+    return TextureRef("file", path=path, origin=f"{t.src}: {t.path(name)} = {_show(value)}")
 
 
-def _builtin_ref(t: _Table, key: str, value: str, size: tuple[int, int]) -> TextureRef:
+def _builtin_ref(t: _Table, key: str, value: str, size: tuple[int, int], origin: str) -> TextureRef:
     name = value.removeprefix("builtin:")
     if name not in BUILTINS:
         raise t.error(key, value, f"unknown builtin texture; expected one of {', '.join(BUILTINS)}")
-    return TextureRef("builtin", name=name, size=size)
+    return TextureRef("builtin", name=name, size=size, origin=origin)
 
 
 def _camera(root: _Table) -> Camera:
@@ -272,6 +286,10 @@ def _camera(root: _Table) -> Camera:
     far = t.number("far", 100.0, lo=0, exclusive=True)
     if far <= near:
         raise t.error("far", t.data.get("far", far), f"expected more than camera.near ({near:g})")
+    if far > near * MAX_DEPTH_RANGE:
+        raise t.error("near", t.data.get("near", near), f"too small for camera.far = {far:g}; expected camera.near "
+                      f">= far / {MAX_DEPTH_RANGE:g} = {far / MAX_DEPTH_RANGE:g} (depth separates surfaces over "
+                      f"that range)")
     return Camera(position, target, up, fov, near, far)
 
 
@@ -290,8 +308,12 @@ def _light(src: str, key: str, data) -> Light:
 
 def _material(src: str, name: str, data, base: Path) -> Material:
     t = _Table(src, f"materials.{name}", data,
-               ("albedo", "normal", "normal_y", "height", "depth", "height_scale", "uv_scale", "channel"))
-    albedo = _texture(t, "albedo", base, color_ok=True, required=True)
+               ("folder", "albedo", "normal", "normal_y", "height", "depth", "height_scale", "uv_scale", "channel"))
+    folder = _folder(t, base)
+    albedo = _texture(t, "albedo", base, color_ok=True, required=folder is None) or (folder and folder["albedo"])
+    if albedo is None:
+        raise t.error("folder", t.data["folder"], "has no albedo (NAME_Color, name_diff_1k, albedo, basecolor or "
+                                                  "diffuse); add one, or give albedo = ...")
     normal = _texture(t, "normal", base)
     if normal is not None and normal.kind != "file":
         raise t.error("normal", t.data["normal"],
@@ -300,21 +322,84 @@ def _material(src: str, name: str, data, base: Path) -> Material:
         raise t.error("depth", t.data["depth"], "both height and depth given; expected only one of them")
     is_depth = "depth" in t.data
     height = _texture(t, "depth" if is_depth else "height", base)
+    if folder is not None:  # keys given in the table win over the folder's files
+        normal = normal if "normal" in t.data else folder["normal"]
+        height = height if "height" in t.data or is_depth else folder["height"]
     channel = t.string("channel", "auto", CHANNELS)
     if channel != "auto":
         if height is None or height.kind != "file":
             raise t.error("channel", channel, "applies to a height/depth file only; expected no channel here")
         height = replace(height, channel=channel)
+    default_y = folder["normal_y"] if folder is not None and "normal" not in t.data else "opengl"
     return Material(
         name=name,
         albedo=albedo,
         normal=normal,
-        normal_y=t.string("normal_y", "opengl", ("opengl", "directx")),
+        normal_y=t.string("normal_y", default_y, ("opengl", "directx")),
         height=height,
         height_is_depth=is_depth,
         height_scale=t.number("height_scale", 0.05, 0, 1),
         uv_scale=t.vector("uv_scale", 2, [1.0, 1.0], lo=0, exclusive=True),
     )
+
+
+def _folder(t: _Table, base: Path) -> dict | None:
+    """``folder = "DIR"``: the material's files found by name (textures.find_material_files); None if absent."""
+    value = t.get("folder", None, "a folder path")
+    if value is None:
+        return None
+    if not isinstance(value, str):
+        raise t.error("folder", value, "expected a folder path (a string)")
+    path = (base / Path(value).expanduser()).resolve()
+    if not path.exists():
+        raise t.error("folder", value, f"folder not found (looked for {path})")
+    try:
+        return folder_refs(path, f"{t.src}: {t.path('folder')} = {_show(value)}")
+    except FileError as error:
+        raise t.error("folder", value, error.reason) from None
+
+
+def folder_refs(path: Path, where: str) -> dict:
+    """albedo/normal/height TextureRefs (None where absent) and normal_y of the material folder ``path``; each
+    file's header checked; problems are reported against ``where`` (and the file's name)."""
+    found = find_material_files(path)
+    refs: dict = {"normal_y": found.normal_y}
+    for slot in ("albedo", "normal", "height"):
+        file = getattr(found, slot)
+        refs[slot] = None
+        if file is not None:
+            try:
+                read_header(file)
+            except FileError as error:
+                raise FileError(path, f"{file.name}: {error.reason}") from None
+            refs[slot] = TextureRef("file", path=file, origin=f"{where} ({file.name})")
+    return refs
+
+
+def with_folder_material(scene: Scene, folder: Path) -> Scene:
+    """``scene`` with the material folder ``folder`` on its first plane (``--material DIR``): its albedo, normal
+    and height files found by name, the plane's relief depth and tiling kept."""
+    where = f"--material {folder}"
+    plane = next((i for i, o in enumerate(scene.objects) if o.kind == "plane"), None)
+    if plane is None:
+        raise UserError(f"{where}: the scene {scene.path or scene.name} has no plane to show the material on; "
+                        "use a scene with a [[objects]] type = \"plane\"")
+    if not folder.exists():
+        raise UserError(f"{where}: folder not found (looked for {folder.resolve()})")
+    try:
+        refs = folder_refs(folder.resolve(), where)
+    except FileError as error:
+        raise UserError(f"{where}: {error.reason}") from None
+    if refs["albedo"] is None:
+        raise UserError(f"{where}: no albedo file (NAME_Color, name_diff_1k, albedo, basecolor or diffuse)")
+    old = scene.materials[scene.objects[plane].material]
+    name = f"folder {folder.name}"
+    material = Material(name=name, albedo=refs["albedo"], normal=refs["normal"], normal_y=refs["normal_y"],
+                        height=refs["height"], height_scale=old.height_scale, uv_scale=old.uv_scale)
+    objects = list(scene.objects)
+    objects[plane] = replace(objects[plane], material=name)
+    return replace(scene, materials={**scene.materials, name: material}, objects=tuple(objects),
+                   name=f"{scene.name} with {folder.name}")
 
 
 def _object(src: str, key: str, data, materials: dict[str, Material]) -> SceneObject:
@@ -374,7 +459,11 @@ def parse_scene(text: str, path: Path | str | None = None) -> Scene:
     section = _Table(src, "scene", doc.get("scene", {}), ("name", "technique", "techniques", "background"))
     technique, techniques, params = _techniques(root, section)
 
-    lights = tuple(_light(src, f"lights[{i}]", x) for i, x in enumerate(root.array_of_tables("lights")))
+    raw_lights = root.array_of_tables("lights")
+    if len(raw_lights) > MAX_LIGHTS:
+        raise UserError(f"{src}: lights: {len(raw_lights)} [[lights]] tables; expected at most {MAX_LIGHTS} "
+                        "(merge lights of the same direction, or drop the faintest)")
+    lights = tuple(_light(src, f"lights[{i}]", x) for i, x in enumerate(raw_lights))
     materials = {
         name: _material(src, name, data, base) for name, data in root.table_of_tables("materials").items()
     }
@@ -405,10 +494,15 @@ def load_scene(path) -> Scene:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise UserError(f"{path}: scene file not found") from None
+    except IsADirectoryError:
+        raise UserError(f"{path}: is a directory; expected a scene .toml file") from None
     except UnicodeDecodeError as e:
         raise UserError(f"{path}: not UTF-8 text ({e.reason} at byte {e.start}); save the scene as UTF-8") from None
     except OSError as e:
         raise UserError(f"{path}: cannot read scene file ({e.strerror})") from None
+    if text.startswith("\ufeff"):
+        raise UserError(f"{path}: starts with a UTF-8 byte-order mark (BOM), which TOML does not allow; "
+                        "save the file as UTF-8 without BOM (most editors: encoding 'UTF-8', not 'UTF-8 with BOM')")
     return parse_scene(text, path)
 
 

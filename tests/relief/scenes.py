@@ -25,3 +25,24 @@ size = [1.0, 1.0]
 [techniques.{technique}]
 {params}
 """
+
+
+def material_scene(techniques, material: str, *, position=(0.0, 1.0, 2.0), camera: str = "", extra: str = "") -> str:
+    """TOML of a 2x2 plane with material ``m`` (its TOML lines ``material``), offering ``techniques``, seen from
+    ``position`` (more ``[camera]`` lines in ``camera``); ``extra`` is appended (lights, objects)."""
+    names = ", ".join(f'"{t}"' for t in techniques)
+    return f"""
+[scene]
+techniques = [{names}]
+[camera]
+position = [{position[0]}, {position[1]}, {position[2]}]
+target = [0.0, 0.0, 0.0]
+{camera}
+[materials.m]
+{material}
+[[objects]]
+type = "plane"
+material = "m"
+size = [2.0, 2.0]
+{extra}
+"""

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.relief.accuracy import measure, random_rays
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
@@ -97,11 +97,74 @@ def test_clamp_addressing_matches_reference(gpu):
 
 def test_probe_rejects_bad_input(gpu):
     h = np.ones((8, 8))
-    with pytest.raises(UserError, match="does not trace rays"):
+    with pytest.raises(InputError, match="does not trace rays"):
         probe("basic", h, [0.5, 0.5], [0, 0, 1])
     with pytest.raises(UserError, match="layers"):
         probe("pom", h, [0.5, 0.5], [0, 0, 1], layers=0)
-    with pytest.raises(UserError, match="NaN"):
+    with pytest.raises(InputError, match="NaN"):
         probe("pom", np.full((8, 8), np.nan), [0.5, 0.5], [0, 0, 1])
     with pytest.raises(UserError, match="unknown technique"):
         probe("nope", h, [0.5, 0.5], [0, 0, 1])
+
+
+@pytest.mark.parametrize("kwargs,message", [
+    ({"height_scale": float("nan")}, "height_scale = nan"),
+    ({"height_scale": -0.01}, "height_scale = -0.01"),
+    ({"height_scale": float("inf")}, "height_scale = inf"),
+    ({"height_scale": 1e30}, "from 0 to 1000"),
+    ({"height": np.full((8, 8), 1.5)}, r"height: heights must lie in \[0, 1\]"),
+    ({"height": np.full((8, 8), -0.5)}, r"height: heights must lie in \[0, 1\]"),
+    ({"height": np.ones(8)}, r"height: expected a 2-D \(H, W\) height map, got shape \(8,\)"),
+    ({"uv": np.zeros((4, 3))}, r"uv must have shape \(2,\) or \(N, 2\), got \(4, 3\)"),
+    ({"view_dir": np.zeros((4, 2))}, r"view_dir must have shape \(3,\) or \(N, 3\), got \(4, 2\)"),
+    ({"uv": np.zeros((4, 2)), "view_dir": np.ones((3, 3))}, "uv has 4 rows but view_dir has 3"),
+    ({"uv": [np.nan, 0.5]}, "uv contains NaN/inf"),
+    ({"address": "mirror"}, "address = 'mirror'"),
+])
+def test_probe_validates_like_exact_hit(gpu, kwargs, message):
+    """Misuse is an InputError (a ValueError) naming the argument, before any GPU work; exact_hit refuses the
+    same inputs (the probe also refuses a finite but float32-overflowing relief depth)."""
+    args = {"height": np.full((8, 8), 0.5), "uv": [0.5, 0.5], "view_dir": [0.0, 0.6, 0.8], "height_scale": 0.05}
+    args.update(kwargs)
+    with pytest.raises(InputError, match=message):
+        probe("pom", args["height"], args["uv"], args["view_dir"], args["height_scale"],
+              address=args.get("address", "repeat"))
+    if kwargs.get("height_scale") == 1e30:
+        return
+    with pytest.raises(ValueError):
+        exact_hit(1.0 - np.asarray(args["height"], float), args["uv"], args["view_dir"], args["height_scale"],
+                  address=args.get("address", "repeat"))
+
+
+def test_probe_with_no_rays_returns_empty_arrays(gpu):
+    got = probe("pom", np.full((8, 8), 0.5), np.zeros((0, 2)), [0.0, 0.6, 0.8])
+    assert got.uv.shape == (0, 2) and got.depth.shape == got.fetches.shape == got.capped.shape == (0,)
+    assert probe("maxmip", np.full((8, 8), 0.5), np.zeros((0, 2)), np.zeros((0, 3))).layers.shape == (0,)
+
+
+@pytest.mark.parametrize("technique", ["pom", "maxmip"])
+def test_far_from_origin_uv_is_traced_as_precisely_as_near_it(gpu, technique):
+    """Repeat addressing is periodic: the probe traces the fraction of uv and adds the integer part back in
+    float64, so uv ~ 1e7 (where float32 spacing is a whole texture) hits exactly where uv ~ 0.3 hits."""
+    h = height_map("bumps", (64, 64))
+    uv, view = random_rays(256, 60, seed=5)
+    near = probe(technique, h, uv, view, 0.05)
+    shift = np.array([1.0e7, -3.0e7])
+    far = probe(technique, h, uv + shift, view, 0.05)
+    assert far.uv.dtype == np.float64 and not far.capped.any()
+    assert np.abs((far.uv - shift) - near.uv).max() < 1e-6
+    ref = exact_hit(1.0 - h, uv + shift, view, 0.05)
+    assert np.percentile(uv_error_texels(far.uv, ref.uv, (64, 64)), 95) <= (0.5 if technique == "pom" else 1e-3)
+
+
+def test_far_from_origin_uv_with_clamp_addressing_is_flagged(gpu):
+    h = height_map("bumps", (64, 64))
+    got = probe("pom", h, [[0.3, 0.4], [0.3, 1e7], [-5e6, 0.5]], [0.0, 0.6, 0.8], 0.05, address="clamp")
+    assert got.capped.tolist() == [False, True, True]
+
+
+def test_non_finite_hits_are_flagged_capped(gpu):
+    """A zero view vector has no direction: whatever the shader makes of it, it is never an unflagged NaN."""
+    got = probe("pom", height_map("bumps", (16, 16)), np.full((3, 2), 0.5), [[0, 0, 0], [0, 0, 1], [1, 0, 0]], 0.05)
+    bad = ~np.isfinite(got.uv).all(axis=1) | ~np.isfinite(got.depth)
+    assert (got.capped | ~bad).all() and not got.capped[1]

@@ -1,4 +1,5 @@
-"""The foundation every other room stands on: errors, GPU acquisition and texture upload, atomic file writes,
+"""The foundation every other room stands on: errors, what both CLIs share (process setup before the GPU driver
+loads, one-line errors and warnings, exit codes), GPU acquisition and texture upload, atomic file writes,
 the one image and height-file reader, CPU texture sampling (nearest/bilinear, repeat/clamp), colour transfer
 functions and the heat ramp, and the one WGSL composer.
 

@@ -9,6 +9,16 @@ class UserError(Exception):
     exit_code = 2
 
 
+class FileError(UserError):
+    """A problem with one input file: ``path`` and ``reason`` (what is wrong and the fix) kept apart, so a caller
+    that knows where the file was named (a scene key) can say so: ``scene.toml: materials.m.height = 'x.png': ...``."""
+
+    def __init__(self, path, reason: str):
+        super().__init__(f"{path}: {reason}")
+        self.path = path
+        self.reason = reason
+
+
 class NoAdapterError(UserError):
     """No wgpu adapter for the requested backend."""
 

@@ -136,22 +136,43 @@ _TEXEL = {  # format -> (numpy dtype, channels)
 }
 
 
-def to_texel_data(data: np.ndarray, fmt: str) -> np.ndarray:
-    """(H, W) or (H, W, C) floats in [0, 1] -> contiguous texel array for ``fmt``."""
-    dtype, channels = _TEXEL[fmt]
-    a = np.asarray(data, dtype=np.float32)
+#: Texels converted and uploaded per step: the conversion's temporaries stay small at any texture size.
+BAND_TEXELS = 1 << 16
+
+
+def _texel_band(band: np.ndarray, dtype, channels: int) -> np.ndarray:
+    a = np.asarray(band, np.float32)
     if a.ndim == 2:
         a = a[:, :, None]
-    if a.shape[2] < channels:  # pad missing channels with 1 (alpha)
-        a = np.concatenate([a, np.ones(a.shape[:2] + (channels - a.shape[2],), np.float32)], axis=2)
-    a = a[:, :, :channels]
+    out = np.ones(a.shape[:2] + (channels,), dtype)  # missing channels (alpha) are 1
+    c = min(a.shape[2], channels)
     if dtype == np.uint8:
-        a = np.clip(np.rint(a * 255.0), 0, 255)
-    return np.ascontiguousarray(a.astype(dtype))
+        out[:, :, :c] = np.clip(np.rint(a[:, :, :c] * 255.0), 0, 255)
+    else:
+        out[:, :, :c] = a[:, :, :c]
+    return out
 
 
-def create_texture(gpu: Gpu, levels: list[np.ndarray], fmt: str, label: str) -> wgpu.GPUTexture:
-    """A sampled 2D texture from a mip chain (``levels[0]`` is the base level)."""
+def _bands(h: int, w: int):
+    step = max(1, BAND_TEXELS // max(w, 1))
+    for row in range(0, h, step):
+        yield row, min(row + step, h)
+
+
+def to_texel_data(data: np.ndarray, fmt: str) -> np.ndarray:
+    """(H, W) or (H, W, C) floats in [0, 1] -> contiguous texel array for ``fmt`` (converted in row bands)."""
+    dtype, channels = _TEXEL[fmt]
+    a = np.asarray(data)
+    out = np.empty(a.shape[:2] + (channels,), dtype)
+    for r0, r1 in _bands(*a.shape[:2]):
+        out[r0:r1] = _texel_band(a[r0:r1], dtype, channels)
+    return out
+
+
+def create_texture(gpu: Gpu, levels, fmt: str, label: str) -> wgpu.GPUTexture:
+    """A sampled 2D texture from a mip chain (``levels[0]`` is the base level; a list, or ``mip_chain``'s lazy
+    chain). Each level is converted and uploaded in row bands, so no full-size texel copy is ever made: peak
+    memory is the caller's base level plus the next level (a quarter of it)."""
     base = levels[0]
     h, w = base.shape[:2]
     limit = gpu.adapter.limits["max-texture-dimension-2d"]
@@ -164,24 +185,50 @@ def create_texture(gpu: Gpu, levels: list[np.ndarray], fmt: str, label: str) -> 
         usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
         mip_level_count=len(levels),
     )
+    dtype, channels = _TEXEL[fmt]
     for level, data in enumerate(levels):
-        texels = to_texel_data(data, fmt)
-        lh, lw = texels.shape[:2]
-        gpu.device.queue.write_texture(
-            {"texture": texture, "mip_level": level, "origin": (0, 0, 0)},
-            texels,
-            {"offset": 0, "bytes_per_row": texels.strides[0], "rows_per_image": lh},
-            (lw, lh, 1),
-        )
+        lh, lw = data.shape[:2]
+        for r0, r1 in _bands(lh, lw):
+            texels = _texel_band(data[r0:r1], dtype, channels)
+            gpu.device.queue.write_texture(
+                {"texture": texture, "mip_level": level, "origin": (0, r0, 0)},
+                texels,
+                {"offset": 0, "bytes_per_row": texels.strides[0], "rows_per_image": r1 - r0},
+                (lw, r1 - r0, 1),
+            )
     return texture
 
 
-def mip_chain(data: np.ndarray) -> list[np.ndarray]:
-    """Average (box-filtered) mip chain down to 1x1; odd sizes round down as WebGPU mips do."""
-    levels = [np.asarray(data, np.float32)]
-    while max(levels[-1].shape[:2]) > 1:
-        h, w = levels[-1].shape[:2]
-        levels.append(cv2.resize(levels[-1], (max(w // 2, 1), max(h // 2, 1)), interpolation=cv2.INTER_AREA))
-        if levels[-1].ndim < levels[0].ndim:  # cv2 drops a trailing channel axis of size 1
-            levels[-1] = levels[-1][..., None]
-    return levels
+class MipChain:
+    """Average (box-filtered) mip chain down to 1x1, odd sizes rounding down as WebGPU mips do; lazy: each level
+    is computed from the one before when iterated, and only those two are alive at a time."""
+
+    def __init__(self, data: np.ndarray):
+        self.base = np.asarray(data, np.float32)
+        self._count = int(max(self.base.shape[:2])).bit_length()
+
+    def __len__(self) -> int:
+        return self._count
+
+    def __iter__(self):
+        level = self.base
+        yield level
+        while max(level.shape[:2]) > 1:
+            h, w = level.shape[:2]
+            level = cv2.resize(level, (max(w // 2, 1), max(h // 2, 1)), interpolation=cv2.INTER_AREA)
+            if level.ndim < self.base.ndim:  # cv2 drops a trailing channel axis of size 1
+                level = level[..., None]
+            yield level
+
+    def __getitem__(self, index: int) -> np.ndarray:
+        if index < 0:
+            index += self._count
+        for i, level in enumerate(self):
+            if i == index:
+                return level
+        raise IndexError(index)
+
+
+def mip_chain(data: np.ndarray) -> MipChain:
+    """The (lazy) mip chain of ``data``: see ``MipChain``."""
+    return MipChain(data)

@@ -1,8 +1,12 @@
 """The one reader of image and array files, for scenes and maptools alike.
 
-``read_image``: an image file (8/16-bit PNG, JPEG, TIFF, ... whatever OpenCV decodes) or a ``.npy`` array as
-float32 in [0, 1], RGB(A) order. ``read_height``: a height (or depth) map from such a file as float32 (H, W) in
-[0, 1], with one channel rule everywhere:
+``read_header``: format, size and channels of a file from its first bytes only (``.npy`` header, PNG, JPEG, EXR,
+and whatever else Pillow identifies), with every limit checked there: a file declaring 60000x60000 is refused at
+once, before any data is read. Empty, truncated, missing and directory inputs are refused there too.
+
+``read_image``: an image file (8/16-bit PNG, JPEG, EXR where the OpenCV build reads it, TIFF, ... whatever OpenCV
+decodes) or a ``.npy`` array as float32 in [0, 1], RGB(A) order. ``read_height``: a height (or depth) map from
+such a file as float32 (H, W) in [0, 1], with one channel rule everywhere:
 
 - ``auto``: a grey file as it is; a colour file whose colour channels are equal as that channel; any other colour
   file as its Rec. 709 luma (a height map is data: no sRGB decoding);
@@ -11,38 +15,208 @@ float32 in [0, 1], RGB(A) order. ``read_height``: a height (or depth) map from s
 - ``luma``: Rec. 709 luma of the colour channels.
 
 Non-finite values (float files) follow ``nan_policy``: ``error`` (refuse), ``zero``, or ``nearest`` (the value of
-the nearest finite texel). Every problem is a one-line ``UserError`` naming the file.
+the nearest finite texel); how many were replaced is logged as a warning. Every problem is a one-line
+``FileError`` (a ``UserError``) naming the file; its ``reason`` lets a caller name the key the file came from.
 """
 
 from __future__ import annotations
 
+import logging
+import os
+import struct
+import threading
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from .errors import UserError
+from .errors import FileError, UserError
+
+# EXR where the OpenCV build has it (OpenCV reads the variable at its first EXR access).
+os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")
 
 HEIGHT_CHANNELS = ("auto", "grey", "r", "g", "b", "a", "luma")
 NAN_POLICIES = ("error", "zero", "nearest")
 REC709 = np.array([0.2126, 0.7152, 0.0722])
 _RGBA = "rgba"
 
+#: Largest side of any image or array read (the WebGPU default 2D texture limit; builtins have the same).
+MAX_SIDE = 8192
+#: Most channels per texel.
+MAX_CHANNELS = 4
+
+log = logging.getLogger("wgpuviewer.images")
+
+_NPY_MAGIC = b"\x93NUMPY"
+_EXR_MAGIC = b"\x76\x2f\x31\x01"
+_PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+_JPEG_MAGIC = b"\xff\xd8\xff"
+_FORMATS = "PNG, JPEG, EXR or .npy"
+_REWRITE = "write or download it again"
+
+
+@dataclass(frozen=True)
+class Header:
+    """What a file's first bytes say: ``format`` (npy, png, jpeg, exr or Pillow's name), ``width``, ``height``,
+    ``channels`` (0 where the header does not say)."""
+
+    format: str
+    width: int
+    height: int
+    channels: int = 0
+
+
+def _npy_header(path: Path, f, size: int) -> Header:
+    try:
+        version = np.lib.format.read_magic(f)
+        read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+        shape, _fortran, dtype = read(f)
+    except Exception as e:  # noqa: BLE001 - any parse failure is the file's fault
+        raise FileError(path, f"cannot read .npy array (bad header: {e}); save it with numpy.save") from None
+    if dtype.hasobject or dtype.kind not in "uif":
+        raise FileError(path, f"unsupported dtype {dtype}; expected uint8, uint16 or float")
+    if len(shape) not in (2, 3) or (len(shape) == 3 and not 1 <= shape[2] <= MAX_CHANNELS):
+        raise FileError(path, f"unsupported shape {shape}; expected (h, w), (h, w, 3) or (h, w, 4)")
+    need = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
+    header = Header("npy", int(shape[1]), int(shape[0]), int(shape[2]) if len(shape) == 3 else 1)
+    _check_limits(path, header, shape)
+    have = size - f.tell()
+    if have < need:
+        raise FileError(path, f"truncated: the header declares {shape} {dtype} ({need} bytes of data) but only "
+                              f"{have} follow; save it again with numpy.save")
+    return header
+
+
+def _exr_header(path: Path, f) -> Header:
+    """OpenEXR: attributes name, type, size, value after magic and version; ``dataWindow`` (box2i) is the size."""
+    f.seek(8)
+    window, channels = None, 0
+    for _ in range(1024):
+        name = _cstring(f)
+        if not name:
+            break
+        kind, (length,) = _cstring(f), struct.unpack("<i", f.read(4) or b"\0\0\0\0")
+        value = f.read(max(length, 0))
+        if len(value) < length:
+            break
+        if name == b"dataWindow" and kind == b"box2i" and length == 16:
+            window = struct.unpack("<4i", value)
+        elif name == b"channels" and kind == b"chlist":
+            channels = value.count(b"\0") // 2  # each channel: name NUL + 16 bytes; the list ends with a NUL
+    if window is None:
+        raise FileError(path, f"cannot read the EXR header (no dataWindow); {_REWRITE}")
+    xmin, ymin, xmax, ymax = window
+    return Header("exr", xmax - xmin + 1, ymax - ymin + 1, channels)
+
+
+def _cstring(f) -> bytes:
+    out = bytearray()
+    while len(out) < 256:
+        c = f.read(1)
+        if not c or c == b"\0":
+            break
+        out += c
+    return bytes(out)
+
+
+_PIL_LOCK = threading.Lock()
+
+
+def _pil_header(path: Path) -> Header:
+    """Pillow reads only the header on ``open``; its own size guard is off here (our limits come after)."""
+    from PIL import Image, UnidentifiedImageError
+
+    with _PIL_LOCK:
+        guard, Image.MAX_IMAGE_PIXELS = Image.MAX_IMAGE_PIXELS, None
+        try:
+            with Image.open(path) as image:
+                (w, h), mode, fmt = image.size, image.mode, (image.format or "image").lower()
+        except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as e:
+            what = "unrecognised contents" if isinstance(e, UnidentifiedImageError) else f"bad header: {e}"
+            raise FileError(path, f"cannot decode image ({what}); use {_FORMATS}") from None
+        finally:
+            Image.MAX_IMAGE_PIXELS = guard
+    return Header(fmt, w, h, Image.getmodebands(mode) if mode in Image.MODES else 0)
+
+
+def _check_limits(path: Path, header: Header, shape=None) -> None:
+    if header.width <= 0 or header.height <= 0:
+        raise FileError(path, f"empty image (shape {shape if shape is not None else (header.height, header.width)})")
+    if max(header.width, header.height) > MAX_SIDE:
+        raise FileError(path, f"{header.width}x{header.height} is larger than the limit of {MAX_SIDE} texels per "
+                              "side; downscale it")
+
+
+def _check_tail(path: Path, f, size: int, fmt: str) -> None:
+    """PNG ends with its IEND chunk, JPEG with its end-of-image marker; a cut file does not."""
+    f.seek(max(size - 1024, 0))
+    tail = f.read()
+    if fmt == "png" and b"IEND" not in tail:
+        raise FileError(path, f"truncated PNG (no IEND chunk at the end); {_REWRITE}")
+    if fmt == "jpeg" and b"\xff\xd9" not in tail:
+        raise FileError(path, f"truncated JPEG (no end-of-image marker); {_REWRITE}")
+
+
+def read_header(path) -> Header:
+    """Format and size of an image or ``.npy`` file from its header, every limit checked (module docstring)."""
+    path = Path(path)
+    try:
+        f = open(path, "rb")  # noqa: SIM115 - closed below
+    except FileNotFoundError:
+        raise FileError(path, "file not found") from None
+    except IsADirectoryError:
+        raise FileError(path, f"is a directory; expected an image or .npy file ({_FORMATS})") from None
+    except OSError as e:
+        raise FileError(path, f"cannot read ({e.strerror or e})") from None
+    with f:
+        if not os.path.isfile(path):
+            raise FileError(path, f"not a regular file; expected an image or .npy file ({_FORMATS})")
+        size = os.fstat(f.fileno()).st_size
+        if size == 0:
+            raise FileError(path, f"empty file (0 bytes); expected an image or .npy file ({_FORMATS})")
+        magic = f.read(8)
+        f.seek(0)
+        if magic.startswith(_NPY_MAGIC):
+            return _npy_header(path, f, size)
+        if path.suffix.lower() == ".npy":
+            raise FileError(path, "cannot read .npy array (no .npy header); save it with numpy.save")
+        if magic.startswith(_EXR_MAGIC):
+            header = _exr_header(path, f)
+            _check_limits(path, header)
+            if not cv2.haveImageReader(str(path)):
+                raise FileError(path, "this OpenCV build cannot read EXR; convert it to a 16-bit PNG or .npy")
+            return header
+        known = "png" if magic.startswith(_PNG_MAGIC) else "jpeg" if magic.startswith(_JPEG_MAGIC) else ""
+        try:
+            header = _pil_header(path)
+        except FileError:
+            if known:  # the signature is there, the rest is not
+                raise FileError(path, f"damaged or truncated {known.upper()} header; write or download it again") \
+                    from None
+            raise
+        _check_limits(path, header)
+        if header.channels > MAX_CHANNELS:
+            raise FileError(path, f"{header.channels} channels; expected at most {MAX_CHANNELS}")
+        if known:
+            _check_tail(path, f, size, known)
+        return header
+
 
 def _decode(path: Path) -> tuple[np.ndarray, bool]:
-    """Raw array of a file and whether its channels are in RGB(A) order (.npy) rather than BGR(A) (OpenCV)."""
-    if not path.is_file():
-        raise UserError(f"{path}: file not found")
-    if path.suffix.lower() == ".npy":
+    """Raw array of a file and whether its channels are in RGB(A) order (.npy) rather than BGR(A) (OpenCV).
+    The header is checked first: nothing over the limits is ever loaded."""
+    header = read_header(path)
+    if header.format == "npy":
         try:
             return np.load(path, allow_pickle=False), True
         except Exception as e:  # noqa: BLE001 - any parse failure is the file's fault
-            raise UserError(f"{path}: cannot read .npy array ({type(e).__name__}: {e}); save it with numpy.save") \
+            raise FileError(path, f"cannot read .npy array ({type(e).__name__}: {e}); save it with numpy.save") \
                 from None
     # imdecode instead of imread: the same decoders, but non-ASCII paths work everywhere.
     data = cv2.imdecode(np.fromfile(path, np.uint8), cv2.IMREAD_UNCHANGED)
     if data is None:
-        raise UserError(f"{path}: cannot decode image (corrupt or unsupported format); use PNG, JPEG or .npy")
+        raise FileError(path, f"cannot decode image (corrupt or unsupported {header.format}); use {_FORMATS}")
     return data, False
 
 
@@ -54,17 +228,17 @@ def _scaled(data: np.ndarray, path: Path) -> np.ndarray:
         return data.astype(np.float32) / np.float32(65535)
     if data.dtype.kind == "f":
         return data.astype(np.float32)
-    raise UserError(f"{path}: unsupported dtype {data.dtype}; expected uint8, uint16 or float")
+    raise FileError(path, f"unsupported dtype {data.dtype}; expected uint8, uint16 or float")
 
 
 def _channels_last(data: np.ndarray, rgb_order: bool, path: Path) -> np.ndarray:
     """(h, w) grey, or (h, w, C) with C in 2 (grey + alpha), 3, 4 in R, G, B(, A) order."""
     if data.size == 0:
-        raise UserError(f"{path}: empty image (shape {data.shape})")
+        raise FileError(path, f"empty image (shape {data.shape})")
     if data.ndim == 3 and data.shape[2] == 1:
         data = data[..., 0]
     if not (data.ndim == 2 or (data.ndim == 3 and data.shape[2] in (2, 3, 4))):
-        raise UserError(f"{path}: unsupported shape {data.shape}; expected (h, w), (h, w, 3) or (h, w, 4)")
+        raise FileError(path, f"unsupported shape {data.shape}; expected (h, w), (h, w, 3) or (h, w, 4)")
     if data.ndim == 3 and data.shape[2] >= 3 and not rgb_order:
         data = data[..., [2, 1, 0, 3][: data.shape[2]]]
     return data
@@ -81,64 +255,68 @@ def read_image(path, channel: str = "auto") -> np.ndarray:
     data = _scaled(_channels_last(raw, rgb_order, path), path)
     bad = int(np.count_nonzero(~np.isfinite(data)))
     if bad:
-        raise UserError(f"{path}: {bad} non-finite values (NaN/inf); clean the data or replace non-finite values")
+        raise FileError(path, f"{bad} non-finite values (NaN/inf); clean the data or replace non-finite values")
     if data.ndim == 3 and data.shape[2] == 2:
         data = data[..., 0] if channel != "a" else data[..., 1]
         return data
     if channel == "auto":
         return data
     if channel not in _RGBA:
-        raise UserError(f"{path}: channel {channel!r}: unknown; expected auto, r, g, b or a")
+        raise FileError(path, f"channel {channel!r}: unknown; expected auto, r, g, b or a")
     present = _RGBA[: data.shape[2]] if data.ndim == 3 else ""
     if channel not in present:
         kind = f"{data.shape[2]}-channel" if present else "greyscale"
-        raise UserError(f"{path}: channel {channel!r} requested but the image is {kind}; use channel 'auto'"
+        raise FileError(path, f"channel {channel!r} requested but the image is {kind}; use channel 'auto'"
                         + (f" or one of {', '.join(present)}" if present else ""))
     return data[..., present.index(channel)]
 
 
-def fill_nonfinite(a: np.ndarray, policy: str, what: str) -> np.ndarray:
-    """Replace NaN/inf texels: error (refuse), zero, or nearest (value of the nearest finite texel, L2)."""
+def fill_nonfinite(a: np.ndarray, policy: str, path) -> np.ndarray:
+    """Replace NaN/inf texels: error (refuse), zero, or nearest (value of the nearest finite texel, L2). How many
+    were replaced is logged as a warning naming ``path``."""
     if policy not in NAN_POLICIES:
         raise UserError(f"--nan-policy {policy!r}: expected one of {', '.join(NAN_POLICIES)}")
     bad = ~np.isfinite(a)
-    if not bad.any():
+    count = int(np.count_nonzero(bad))
+    if not count:
         return a
     if policy == "error":
-        raise UserError(f"{what}: {int(bad.sum())} non-finite values (NaN/inf); clean the data "
-                        "(maptools: --nan-policy zero|nearest replaces them)")
+        raise FileError(path, f"{count} non-finite values (NaN/inf); clean the data "
+                              "(maptools: --nan-policy zero|nearest replaces them)")
+    if count == a.size:
+        raise FileError(path, "every texel is NaN/inf; nothing to fill from")
     a = a.copy()
     if policy == "zero":
         a[bad] = 0.0
-        return a
-    if bad.all():
-        raise UserError(f"{what}: every texel is NaN/inf; nothing to fill from")
-    # Each finite texel is a zero pixel with its own label (row-major order); every other texel gets the label
-    # of its nearest zero pixel.
-    _, labels = cv2.distanceTransformWithLabels(bad.astype(np.uint8), cv2.DIST_L2, 5,
-                                                labelType=cv2.DIST_LABEL_PIXEL)
-    a[bad] = a[~bad][labels[bad] - 1]
+    else:
+        # Each finite texel is a zero pixel with its own label (row-major order); every other texel gets the label
+        # of its nearest zero pixel.
+        _, labels = cv2.distanceTransformWithLabels(bad.astype(np.uint8), cv2.DIST_L2, 5,
+                                                    labelType=cv2.DIST_LABEL_PIXEL)
+        a[bad] = a[~bad][labels[bad] - 1]
+    log.warning(f"{path}: {count} of {a.size} texels were NaN/inf; replaced ({policy}: "
+                f"{'0' if policy == 'zero' else 'the nearest finite value'})")
     return a
 
 
 def _height_channel(data: np.ndarray, channel: str, path: Path) -> np.ndarray:
     if data.ndim == 2:
         if channel == "a":
-            raise UserError(f"{path}: channel 'a' requested but the image is greyscale; use channel 'auto'")
+            raise FileError(path, "channel 'a' requested but the image is greyscale; use channel 'auto'")
         return data
     if data.shape[2] == 2:  # grey + alpha
         return data[..., 1] if channel == "a" else data[..., 0]
     rgb = data[..., :3]
     if channel == "a":
         if data.shape[2] < 4:
-            raise UserError(f"{path}: channel 'a' requested but the image is 3-channel (no alpha); "
-                            "use channel 'auto' or one of r, g, b")
+            raise FileError(path, "channel 'a' requested but the image is 3-channel (no alpha); "
+                                  "use channel 'auto' or one of r, g, b")
         return data[..., 3]
     if channel in ("r", "g", "b"):
         return rgb[..., "rgb".index(channel)]
     equal = np.array_equal(rgb[..., 0], rgb[..., 1]) and np.array_equal(rgb[..., 0], rgb[..., 2])
     if channel == "grey" and not equal:
-        raise UserError(f"{path}: colour image with different channels; choose channel r|g|b|a|luma")
+        raise FileError(path, "colour image with different channels; choose channel r|g|b|a|luma")
     if equal and channel != "luma":
         return rgb[..., 0]
     return (rgb.astype(np.float64) @ REC709).astype(np.float32)
@@ -151,16 +329,16 @@ def read_height(path, channel: str = "auto", nan_policy: str = "error", *, is_de
     """
     path = Path(path)
     if channel not in HEIGHT_CHANNELS:
-        raise UserError(f"{path}: channel {channel!r}: unknown; expected one of {', '.join(HEIGHT_CHANNELS)}")
+        raise FileError(path, f"channel {channel!r}: unknown; expected one of {', '.join(HEIGHT_CHANNELS)}")
     if nan_policy not in NAN_POLICIES:
         raise UserError(f"--nan-policy {nan_policy!r}: expected one of {', '.join(NAN_POLICIES)}")
     raw, rgb_order = _decode(path)
     if raw.dtype == bool or raw.dtype.kind not in "uif":
-        raise UserError(f"{path}: unsupported dtype {raw.dtype}; expected uint8, uint16 or float")
+        raise FileError(path, f"unsupported dtype {raw.dtype}; expected uint8, uint16 or float")
     data = _height_channel(_scaled(_channels_last(raw, rgb_order, path), path), channel, path)
-    data = fill_nonfinite(np.ascontiguousarray(data, np.float32), nan_policy, str(path))
+    data = fill_nonfinite(np.ascontiguousarray(data, np.float32), nan_policy, path)
     lo, hi = float(data.min()), float(data.max())
     if lo < 0 or hi > 1:
         what = "depth" if is_depth else "height"
-        raise UserError(f"{path}: {what} values range from {lo:g} to {hi:g}; expected [0, 1] (normalise the data)")
-    return (1 - data if is_depth else data).astype(np.float32)
+        raise FileError(path, f"{what} values range from {lo:g} to {hi:g}; expected [0, 1] (normalise the data)")
+    return (1 - data if is_depth else data).astype(np.float32, copy=False)

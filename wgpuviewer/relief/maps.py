@@ -63,10 +63,11 @@ def cell_max_height(depth: np.ndarray) -> np.ndarray:
     patch over it never rises above its highest corner, so a max pyramid over these values bounds the sampled
     surface (a pyramid over the texels alone does not: a patch reaches into the neighbouring texel's cell).
     """
-    h = 1.0 - np.asarray(depth, np.float64)
-    right = np.roll(h, -1, axis=1)
-    cell = np.maximum(np.maximum(h, right), np.maximum(np.roll(h, -1, axis=0), np.roll(right, -1, axis=0)))
-    return np.clip(cell, 0.0, 1.0).astype(np.float32)
+    # 1 - depth in the input's precision, then float32 (rounding commutes with the maxima): few temporaries.
+    h = (1.0 - np.asarray(depth)).astype(np.float32, copy=False)
+    cell = np.maximum(h, np.roll(h, -1, axis=1))
+    np.maximum(cell, np.roll(cell, -1, axis=0), out=cell)  # the rows below: their own max of two columns
+    return np.clip(cell, 0.0, 1.0, out=cell)
 
 
 def maxmip_atlas(levels: list[np.ndarray]) -> np.ndarray:

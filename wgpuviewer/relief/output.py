@@ -71,7 +71,7 @@ def save_rgb_png(path: Path, rgb: np.ndarray) -> None:
     if not ok:
         raise UserError(f"{path}: could not encode the PNG")
     with atomic_open(path) as f:  # readers never see a partial file
-        f.write(encoded.tobytes())
+        f.write(encoded)
 
 
 def save_output(path: Path, image: OffscreenImage, mode: str) -> None:

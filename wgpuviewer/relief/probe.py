@@ -2,6 +2,13 @@
 
 The probe composes the same ``trace`` function the fragment shader uses (shaders.compose_technique), so
 what it measures is what the renderer draws. Compare its hits with ``wgpuviewer.reference.exact_hit``.
+
+Inputs are checked like ``exact_hit`` checks them (shapes naming the array, finite values, heights in [0, 1],
+``height_scale`` finite and in [0, MAX_HEIGHT_SCALE]); misuse raises ``InputError`` (a ValueError). The GPU
+traces in float32, which cannot hold a fraction of a texel far from the origin (at uv ~ 1e7 the spacing of
+float32 is a whole texture): with repeat addressing the integer part of each entry uv is removed in float64
+before tracing and added back to the hit (exact: repeat is periodic); with clamp addressing, rays entering
+farther out than float32 resolves to 1/64 texel are flagged ``capped``. So is any ray whose hit is not finite.
 """
 
 from __future__ import annotations
@@ -11,7 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import wgpu
 
-from wgpuviewer.core.errors import UserError
+from maptools import validate_height
+from wgpuviewer.core.errors import InputError
 from wgpuviewer.core.gpu import Gpu, get_gpu
 
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_entries
@@ -22,11 +30,15 @@ RAY_STRIDE = 32  # ProbeRay: vec2f uv, vec2f pad, vec4f view
 HIT_STRIDE = 32  # ProbeHit: vec2f uv, f32 depth, u32 fetches, u32 capped, u32 layers, vec2u pad
 _WORKGROUP = 64
 _MAX_GROUPS = 65535  # per dispatch dimension
+#: Largest relief depth the probe traces (UV units): beyond it float32 steps overflow; scenes allow up to 1.
+MAX_HEIGHT_SCALE = 1e3
+#: Clamp addressing: entry uv farther out than this many texels of float32 resolution (2^-6 texel) is flagged.
+_CLAMP_RESOLVED = 2.0 ** (23 - 6)
 
 
 @dataclass
 class ProbeResult:
-    uv: np.ndarray  # (N, 2) float32 hit uv, not wrapped
+    uv: np.ndarray  # (N, 2) float64 hit uv, not wrapped (the entry's integer part added back in float64)
     depth: np.ndarray  # (N,) float32 hit layer depth t
     fetches: np.ndarray  # (N,) uint32 depth fetches per ray
     capped: np.ndarray  # (N,) bool: a cap or clamp decided the result
@@ -84,29 +96,69 @@ def probe(
 
     height: (H, W) height map in [0, 1] (1 = top; the GPU gets depth = 1 - height). The maps the
     technique needs are built from it (cached by maptools), exactly as the renderer builds them.
-    uv: (N, 2) entry points; view_dir: (N, 3) or (3,) tangent-space V (towards the eye).
+    uv: (N, 2) or (2,) entry points; view_dir: (N, 3) or (3,) tangent-space V (towards the eye); one of them
+    broadcasts against the other, and N = 0 gives an empty result. height_scale: relief depth in UV units.
     params: technique parameters (e.g. ``layers=64``), validated against the registry.
     """
     tech = get_technique(technique)
     if not tech.ray_search:
         names = ", ".join(name for name, t in TECHNIQUES.items() if t.ray_search)
-        raise UserError(f"technique {technique!r} does not trace rays; ray-search techniques: {names}")
+        raise InputError(f"probe: technique {technique!r} does not trace rays; ray-search techniques: {names}")
     values = resolve_params(tech, params)
-    height = np.asarray(height, np.float64)
-    if height.ndim != 2 or height.size == 0:
-        raise UserError(f"probe: height map must be a non-empty 2D array, got shape {height.shape}")
-    if not np.isfinite(height).all():
-        raise UserError("probe: height map contains NaN or inf; clean the data first")
+    height = validate_height(height, "probe: height", dtype=np.float64, error=InputError)
     if address not in ("repeat", "clamp"):
-        raise UserError(f"probe: address = {address!r}; expected 'repeat' or 'clamp'")
-    uv = np.atleast_2d(np.asarray(uv, np.float32))
-    view = np.atleast_2d(np.asarray(view_dir, np.float32))
-    n = max(len(uv), len(view))
+        raise InputError(f"probe: address = {address!r}; expected 'repeat' or 'clamp'")
+    scale = _check_height_scale(height_scale)
+    uv = _rows(uv, 2, "uv")
+    view = _rows(view_dir, 3, "view_dir")
+    if len(uv) != len(view) and 1 not in (len(uv), len(view)):
+        raise InputError(f"probe: uv has {len(uv)} rows but view_dir has {len(view)}; expected equal counts, or "
+                         "one row for all")
+    n = max(len(uv), len(view)) if len(uv) and len(view) else 0
     uv = np.broadcast_to(uv, (n, 2))
     view = np.broadcast_to(view, (n, 3))
-    if not (np.isfinite(uv).all() and np.isfinite(view).all()):
-        raise UserError("probe: uv and view_dir must be finite")
+    if n == 0:
+        return ProbeResult(uv=np.zeros((0, 2)), depth=np.zeros(0, np.float32), fetches=np.zeros(0, np.uint32),
+                           capped=np.zeros(0, bool), layers=np.zeros(0, np.uint32))
+    if address == "repeat":  # periodic: trace the fraction, add the integer part back in float64
+        offset = np.floor(uv)
+        far = np.zeros(n, bool)
+    else:
+        offset = np.zeros_like(uv)
+        far = (np.abs(uv) > _CLAMP_RESOLVED / max(height.shape)).any(axis=1)
+    hits = _trace(tech, values, height, uv - offset, view, scale, address, backend)
+    hits.uv = hits.uv + offset
+    hits.capped |= far | ~np.isfinite(hits.uv).all(axis=1) | ~np.isfinite(hits.depth)
+    return hits
 
+
+def _check_height_scale(height_scale) -> float:
+    try:
+        scale = float(height_scale)
+    except (TypeError, ValueError):
+        raise InputError(f"probe: height_scale = {height_scale!r}; expected a number") from None
+    if not (np.isfinite(scale) and 0.0 <= scale <= MAX_HEIGHT_SCALE):
+        raise InputError(f"probe: height_scale = {height_scale!r}; expected a finite relief depth from 0 to "
+                         f"{MAX_HEIGHT_SCALE:g} UV units")
+    return scale
+
+
+def _rows(a, width: int, name: str) -> np.ndarray:
+    """(width,) or (N, width) finite values -> float64 (N, width); the error names the array."""
+    arr = np.asarray(a, np.float64)
+    if arr.ndim == 1 and arr.shape[0] == width:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != width:
+        raise InputError(f"probe: {name} must have shape ({width},) or (N, {width}), got {np.shape(a)}")
+    if not np.isfinite(arr).all():
+        raise InputError(f"probe: {name} contains NaN/inf; expected finite values")
+    return arr
+
+
+def _trace(tech, values: dict, height: np.ndarray, uv: np.ndarray, view: np.ndarray, height_scale: float,
+           address: str, backend) -> ProbeResult:
+    """Run the technique's probe kernel on the rays (uv, view: float64 (n, 2), (n, 3), n >= 1)."""
+    n = len(uv)
     gpu = get_gpu(backend, quiet=True)
     device = gpu.device
     pipeline, (io_layout, material_layout) = _pipeline(gpu, tech.name)
@@ -121,7 +173,7 @@ def probe(
         label="probe:params", data=pack_trace_params(tech, height_scale, height.shape, values), usage=S.UNIFORM
     )
     depth = 1.0 - height
-    maps = [(n, MAP_SLOTS[n].build(gpu, depth, height_scale, f"probe:{n}")) for n in _derived(tech)]
+    maps = [(name, MAP_SLOTS[name].build(gpu, depth, height_scale, f"probe:{name}")) for name in _derived(tech)]
     mode = wgpu.AddressMode.repeat if address == "repeat" else wgpu.AddressMode.clamp_to_edge
     sampler = device.create_sampler(
         label="probe:sampler", address_mode_u=mode, address_mode_v=mode, mag_filter="linear", min_filter="linear"
@@ -154,6 +206,6 @@ def probe(
     raw = np.frombuffer(device.queue.read_buffer(hit_buf), np.uint8).reshape(n, HIT_STRIDE)
     f32 = raw.view(np.float32)
     u32 = raw.view(np.uint32)
-    return ProbeResult(uv=f32[:, 0:2].copy(), depth=f32[:, 2].copy(), fetches=u32[:, 3].copy(), capped=u32[:, 4] != 0,
-                       layers=u32[:, 5].copy())
+    return ProbeResult(uv=f32[:, 0:2].astype(np.float64), depth=f32[:, 2].copy(), fetches=u32[:, 3].copy(),
+                       capped=u32[:, 4] != 0, layers=u32[:, 5].copy())
 

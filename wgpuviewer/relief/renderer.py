@@ -9,6 +9,8 @@ resource it builds, so tests (and curious users) can see exactly what a scene co
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,6 +19,7 @@ import wgpu
 from maptools.cache import cached_generate
 from wgpuviewer import camera as cam
 from wgpuviewer import meshes, textures
+from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 from wgpuviewer.scene import Camera, Scene
 
@@ -118,6 +121,24 @@ class Renderer:
 
     # --- lazily built material resources -----------------------------------------------------
 
+    def missing(self, technique: str) -> list[tuple[str, str]]:
+        """(material, slot) of the textures drawing ``technique`` needs and the renderer has not built yet."""
+        t = get_technique(technique)
+        used = dict.fromkeys(m for m, *_ in self._objects)  # scene order, each once
+        return [(m, k) for m in used for k in t.textures if (m, k) not in self._textures]
+
+    def prepare(self, technique: str, progress: Callable[[str, int, int], None] | None = None) -> None:
+        """Build every texture ``technique`` needs now (loading files, deriving maps), reporting each step as
+        ``progress(label, done, total)``: what ``render``/``encode`` would otherwise build on first use. The
+        viewer calls it from a worker thread while it keeps drawing; problems raise UserError naming the key."""
+        todo = self.missing(technique)
+        for done, (material, kind) in enumerate(todo):
+            if progress is not None:
+                progress(f"{material}.{kind}", done, len(todo))
+            self.texture(material, kind)
+        if progress is not None:
+            progress("done", len(todo), len(todo))
+
     def texture(self, material_name: str, kind: str) -> wgpu.GPUTexture:
         """The GPU texture of slot ``kind`` (maps.MAP_SLOTS) of a material, built on first use."""
         key = (material_name, kind)
@@ -126,10 +147,18 @@ class Renderer:
             label = f"{material_name}.{kind}"
             slot = MAP_SLOTS[kind]
             if slot.derived:
-                self._textures[key] = slot.build(self.gpu, self._depth_data(material), material.height_scale, label)
+                depth = self._depth_data(material)
+                with _reported_against_height(material, kind):
+                    self._textures[key] = slot.build(self.gpu, depth, material.height_scale, label)
             else:
-                data = self._normal_data(material) * 0.5 + 0.5 if kind == "normal" else textures.load_albedo(material.albedo)
+                if kind == "normal":
+                    data = self._normal_data(material)  # our own copy: encoded in place, n * 0.5 + 0.5
+                    data *= 0.5
+                    data += 0.5
+                else:
+                    data = textures.load_albedo(material.albedo)
                 self._textures[key] = create_texture(self.gpu, mip_chain(data), _MATERIAL_FORMATS[kind], label)
+                del data
             self.created.append(f"texture:{label}")
         return self._textures[key]
 
@@ -152,7 +181,8 @@ class Renderer:
         # Slopes of the actual relief: height_scale UV units deep over a texture width of 1 UV unit.
         # maptools' "directx" convention has +y towards increasing rows, which is +v here.
         strength = material.height_scale * height.shape[1]
-        return cached_generate("normal", height, backend="cpu", strength=strength, y="directx")
+        with _reported_against_height(material, "normal"):
+            return cached_generate("normal", height, backend="cpu", strength=strength, y="directx")
 
     def _material_layout(self, technique: Technique) -> wgpu.GPUBindGroupLayout:
         if technique.textures not in self._material_layouts:
@@ -204,7 +234,8 @@ class Renderer:
                     "buffers": [{"array_stride": meshes.VERTEX_STRIDE, "attributes": meshes.VERTEX_ATTRIBUTES}],
                 },
                 primitive={"topology": "triangle-list", "cull_mode": "back", "front_face": "ccw"},
-                depth_stencil={"format": DEPTH_FORMAT, "depth_write_enabled": True, "depth_compare": "less"},
+                # Reversed Z (camera.perspective): 1 at near, 0 at far; the nearer surface has the greater depth.
+                depth_stencil={"format": DEPTH_FORMAT, "depth_write_enabled": True, "depth_compare": "greater"},
                 fragment={
                     "module": module,
                     "entry_point": "fs_color" if len(formats) == 1 else "fs_data",
@@ -240,8 +271,8 @@ class Renderer:
         view_proj = cam.perspective(camera.fov, w / h, camera.near, camera.far) @ cam.look_at(
             camera.position, camera.target, camera.up
         )
-        lights = np.zeros((MAX_LIGHTS, 8), np.float32)
-        for i, light in enumerate(self.scene.lights[:MAX_LIGHTS]):
+        lights = np.zeros((len(self.scene.lights), 8), np.float32)  # the scene checked the count (MAX_LIGHTS)
+        for i, light in enumerate(self.scene.lights):
             if light.kind == "directional":
                 lights[i, :4] = [*(-np.asarray(light.direction)), 0.0]  # towards the light
             else:
@@ -249,7 +280,7 @@ class Renderer:
             lights[i, 4:7] = np.asarray(light.color) * light.intensity
         header = np.zeros(8, np.float32)
         header[:3] = camera.position
-        counts = np.array([min(len(self.scene.lights), MAX_LIGHTS), MODES[mode]], np.uint32)
+        counts = np.array([len(self.scene.lights), MODES[mode]], np.uint32)
         scalars = np.array([technique.cost_scale(params), *layer_range(params), 0.0, 0.0, 0.0], np.float32)
         data = b"".join([cam.to_wgsl(view_proj).tobytes(), header[:4].tobytes(), counts.tobytes(),
                          scalars.tobytes(), lights.tobytes()])
@@ -303,7 +334,7 @@ class Renderer:
             label=f"frame:{technique.name}",
             color_attachments=attachments,
             depth_stencil_attachment={
-                "view": depth_view, "depth_load_op": "clear", "depth_store_op": "discard", "depth_clear_value": 1.0,
+                "view": depth_view, "depth_load_op": "clear", "depth_store_op": "discard", "depth_clear_value": 0.0,
             },
             timestamp_writes=timestamp_writes,
         )
@@ -344,6 +375,19 @@ class Renderer:
             layers=_read_texture(device, layers, 1, np.uint32)[:, :, 0],
             layer_range=layer_range(draw.values),
         )
+
+
+@contextlib.contextmanager
+def _reported_against_height(material, kind: str):
+    """A map derived from a material's height map that cannot be built (too large for a limit, ...) is reported
+    against the height key of the scene, not against the derived map the user never named."""
+    try:
+        yield
+    except UserError as error:
+        ref = material.height
+        if ref is None or not ref.origin:
+            raise
+        raise ref.error(f"its {kind} map cannot be built: {error}") from None
 
 
 def layer_range(params: dict) -> tuple[float, float]:

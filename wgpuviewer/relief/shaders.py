@@ -12,12 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from wgpuviewer.core.wgsl import Generated, Module, compose
+from wgpuviewer.scene import MAX_LIGHTS
 
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding
 from .techniques import MAX_LAYERS, Technique
 
-#: Render entry constants the renderer sizes its buffers with (generated into entry/render.wgsl's module).
-MAX_LIGHTS = 4
+# MAX_LIGHTS (the scene format's limit) sizes the Frame uniform's light array (generated into render.wgsl).
 
 
 def _f32(x: float) -> str:

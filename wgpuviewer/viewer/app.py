@@ -27,16 +27,19 @@ import numpy as np
 import wgpu
 
 from wgpuviewer.camera import normalize
-from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.cli import terminal_progress
+from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.core.gpu import get_gpu
+from wgpuviewer.core.io import refuse_directory
 from wgpuviewer.relief.output import save_rgb_png
 from wgpuviewer.relief.renderer import DEPTH_FORMAT, DrawConfig, Renderer
 from wgpuviewer.relief.techniques import get_technique
 from wgpuviewer.scene import Camera, Scene
 
+from .builds import MapBuild
 from .cameras import FlyCamera, OrbitCamera
 from .keys import FLY_KEYS, PRESSED
-from .settings import LIMITS, Settings, save_settings
+from .settings import CONFIG_ENV, LIMITS, Settings, save_settings, settings_path
 from .stats import FrameStats, GpuTimer
 
 MODES = ("color", "cost", "error")
@@ -76,6 +79,7 @@ class Viewer:
         size: tuple[int, int] | None = None,
         hud: bool = True,
         scripted: bool = False,
+        background: bool | None = None,
     ):
         RenderCanvas, self.loop = _canvas_class(gui)
         self.gui = gui
@@ -84,6 +88,15 @@ class Viewer:
         self.scene = scene
         self.gpu = get_gpu(backend)
         self.renderer = Renderer(scene, self.gpu)
+        # What the first technique needs is built before the window opens (a bad file: one line, exit 2).
+        with terminal_progress(f"maps for {technique}") as progress:
+            self.renderer.prepare(technique, progress)
+        #: Later techniques build on a worker thread while the window draws on (scripted runs: in the frame).
+        self.background = (not scripted) if background is None else background
+        self.build: MapBuild | None = None
+        self.wanted: dict[str, str] = {}  # side -> the technique last asked for there (while building)
+        self.problems: list[str] = []  # shown in red in the HUD: a technique that could not be built, ...
+        self.problem_time = 0.0
         #: Live parameters per technique (the HUD edits them) and relief-depth overrides per technique.
         self.params = {name: dict(values) for name, values in scene.technique_params.items()}
         self.height_scales: dict[str, float] = {}
@@ -166,6 +179,14 @@ class Viewer:
         self.fly.sensitivity = self.orbit.sensitivity = float(value)
 
     def set_mode(self, mode: str):
+        if mode == "error":  # the error view compares against its reference technique: build what it needs
+            from .error_view import REFERENCE
+
+            try:
+                self.renderer.prepare(REFERENCE)
+            except (UserError, InputError) as error:
+                self.problem(f"error view: {error}")
+                return
         self.mode = mode
         self._error_key = None
         self._update_title()
@@ -191,12 +212,62 @@ class Viewer:
             self.fly.pitch = float(np.arcsin(np.clip(f[1], -1.0, 1.0)))
         self.camera_mode = mode
 
-    def set_technique(self, name: str):
-        if self.split and self.active_side == "B":
+    def set_technique(self, name: str, side: str | None = None):
+        """Show ``name`` on the active half (or ``side``) once what it needs is built; until then the half keeps
+        its technique. A problem (a bad texture file) is shown in the HUD and the technique stays."""
+        side = side or ("B" if self.split and self.active_side == "B" else "A")
+        self.wanted[side] = name
+        if self.ready(name):
+            self._show(side, name)
+        elif not self.background:
+            try:
+                self.renderer.prepare(name)
+            except (UserError, InputError) as error:
+                self.problem(str(error))
+                return
+            self._show(side, name)
+        elif self.build is None:
+            self.build = MapBuild(self.renderer, name, side)
+        self._update_title()
+
+    def ready(self, name: str) -> bool:
+        return not self.renderer.missing(name)
+
+    def _show(self, side: str, name: str):
+        if side == "B":
             self.technique_b = name
         else:
             self.technique = name
         self._update_title()
+
+    def _poll_build(self):
+        """A finished build: show its technique where it is still wanted, or report its problem; then build
+        what was asked for meanwhile."""
+        build = self.build
+        if build is None or not build.finished:
+            return
+        self.build = None
+        if build.error:
+            self.problem(build.error)
+            if self.wanted.get(build.side) == build.technique:  # not asked for again until a key asks
+                self.wanted[build.side] = self.technique_b if build.side == "B" else self.technique
+        elif self.wanted.get(build.side) == build.technique:
+            self._show(build.side, build.technique)
+        for side, name in self.wanted.items():
+            if self.build is None and not self.ready(name):
+                self.build = MapBuild(self.renderer, name, side)
+
+    def problem(self, text: str):
+        """A problem the viewer survives (shown in red in the HUD for a while, and on stderr)."""
+        self.problems.append(text)
+        self.problem_time = time.perf_counter()
+        print(f"wgpuviewer: error: {text}", file=sys.stderr)
+
+    def current_problem(self, seconds: float = 20.0) -> str | None:
+        """The last problem, while it is recent enough to show."""
+        if self.problems and time.perf_counter() - self.problem_time < seconds:
+            return self.problems[-1]
+        return None
 
     def set_vsync(self, on: bool):
         """Vsync picks the surface present mode (fifo vs immediate/mailbox); it needs a reconfigure."""
@@ -307,6 +378,9 @@ class Viewer:
     def toggle_split(self, key: str):
         self.split = not self.split
         self.active_side = "A"
+        if self.split and not self.ready(self.technique_b):  # B draws A's technique until its maps are built
+            wanted, self.technique_b = self.technique_b, self.technique
+            self.set_technique(wanted, "B")
 
     def switch_half(self, key: str):
         self.active_side = "B" if self.active_side == "A" and self.split else "A"
@@ -423,6 +497,7 @@ class Viewer:
         self._error_key, self._error_time = key, now
 
     def draw(self):
+        self._poll_build()
         now = time.perf_counter()
         dt, self._last_time = min(now - self._last_time, 0.1), now
         self.stats.tick(now)
@@ -476,7 +551,10 @@ class Viewer:
         if getattr(self, "_want_screenshot", False):  # the scene without the HUD
             self._want_screenshot = False
             device.queue.submit([encoder.finish()])
-            self.screenshot(texture)
+            try:
+                self.screenshot(texture)
+            except UserError as error:  # e.g. a read-only working folder: say so, keep drawing
+                self.problem(str(error))
             encoder = device.create_command_encoder(label="window:hud")
         if self.hud is not None:
             self.hud.encode(encoder, view)
@@ -560,6 +638,18 @@ class _ErrorLogCounter(logging.Handler):
         self.count += 1
 
 
+def save_session(settings: Settings) -> None:
+    """Save the settings at the end of a session; a folder that cannot be written is a warning naming it and
+    the variable that moves it, never a failed session."""
+    try:
+        path = save_settings(settings)
+        print(f"settings saved to {path}", file=sys.stderr)
+    except (OSError, UserError) as error:
+        reason = getattr(error, "strerror", None) or str(error)
+        print(f"wgpuviewer: warning: settings not saved: {settings_path()} cannot be written ({reason}); "
+              f"set {CONFIG_ENV} to a writable folder", file=sys.stderr)
+
+
 def run_viewer(
     scene: Scene, technique: str, *, backend=None, frames=None, screenshot=None, keys=(),
     gui: str = "glfw", settings: Settings | None = None, size=None, save: bool | None = None,
@@ -567,10 +657,12 @@ def run_viewer(
     """Open the window. Interactive runs save the settings on exit (``save``); scripted ones don't."""
     if frames is not None and frames < 1:
         raise UserError(f"--frames {frames}: expected a positive number of frames")
-    if screenshot and frames is None:
-        frames = max(len(keys), 0) + 3  # a screenshot implies a scripted run
-    if screenshot and not screenshot.lower().endswith(".png"):
-        raise UserError(f"--screenshot {screenshot}: expected a .png path")
+    if (screenshot or keys) and frames is None:
+        frames = len(keys) + 3  # a screenshot or keys to press imply a scripted run, which ends by itself
+    if screenshot:
+        refuse_directory(screenshot, "shot.png")
+        if not screenshot.lower().endswith(".png"):
+            raise UserError(f"--screenshot {screenshot}: expected a .png path")
     unknown = [k for k in keys if k not in PRESSED]
     if unknown:
         raise UserError(f"--keys: unknown key {unknown[0]!r}; known: {', '.join(sorted(PRESSED))}")
@@ -581,9 +673,8 @@ def run_viewer(
               file=sys.stderr)
     code = viewer.run(frames, screenshot, keys)
     if save if save is not None else not scripted:
-        try:
-            path = save_settings(viewer.current_settings())
-            print(f"settings saved to {path}", file=sys.stderr)
-        except OSError as error:
-            print(f"wgpuviewer: warning: could not save settings ({error})", file=sys.stderr)
+        save_session(viewer.current_settings())
+    if code == 0 and scripted and viewer.problems:  # a scripted run reports what the HUD showed
+        print(f"wgpuviewer: error: {viewer.problems[0]}", file=sys.stderr)
+        return 2
     return code

@@ -28,6 +28,9 @@ WHITE = (1.0, 1.0, 1.0, 1.0)
 YELLOW = (1.0, 0.85, 0.3, 1.0)
 RED = (1.0, 0.35, 0.3, 1.0)
 GREY = (0.7, 0.7, 0.7, 1.0)
+MARGIN = 8.0
+#: Below this window size (logical pixels) the HUD is compact.
+COMPACT_SIZE = (640, 400)
 
 
 class Hud:
@@ -37,6 +40,7 @@ class Hud:
         io = imgui.get_io()
         io.set_ini_filename("")  # window positions are not persisted next to the user's cwd
         self.drawn_panels: list[str] = []  # what the last frame showed (tests, debugging)
+        self.rects: dict[str, tuple[float, float, float, float]] = {}  # panel -> (x, y, w, h) in the last frame
 
     def encode(self, encoder, view) -> None:
         """Build this frame's UI and record it into ``view``."""
@@ -59,15 +63,24 @@ class Hud:
 
     # --- panels --------------------------------------------------------------------------------
 
+    def _record(self, name: str) -> None:
+        """Inside a panel: note it was drawn, and where (tests check the layout fits small windows)."""
+        (x, y), (w, h) = imgui.get_window_pos(), imgui.get_window_size()
+        self.rects[name] = (x, y, w, h)
+        self.drawn_panels.append(name)
+
     def build(self) -> None:
         v = self.viewer
         self.drawn_panels = []
+        self.rects = {}
         if not v.show_hud:
             return
         width, height = imgui.get_io().display_size
+        #: Small windows (e.g. 320x240): short statistics, the technique panel collapsed beside them, no overlap.
+        self.compact = width < COMPACT_SIZE[0] or height < COMPACT_SIZE[1]
         flags = imgui.WindowFlags_.always_auto_resize | imgui.WindowFlags_.no_focus_on_appearing
         if v.show_stats:
-            self._stats_panel(flags)
+            self._stats_panel(flags, width)
         self._info_panel(flags, width)
         if v.show_help:
             self._help_panel(flags, width, height)
@@ -75,23 +88,29 @@ class Hud:
             self._legend(width, height)
         if v.split:
             self._split_labels(width)
-        self._status(flags, height)
+        self._status(flags, width, height)
 
-    def _stats_panel(self, flags) -> None:
+    def _stats_panel(self, flags, width) -> None:
         v = self.viewer
-        imgui.set_next_window_pos((10, 10), imgui.Cond_.first_use_ever)
+        imgui.set_next_window_pos((MARGIN, MARGIN), imgui.Cond_.always if self.compact else imgui.Cond_.first_use_ever)
+        if self.compact:
+            imgui.set_next_window_size_constraints((0, 0), (width / 2 - 1.5 * MARGIN, 1e4))
         imgui.set_next_window_bg_alpha(0.6)
-        imgui.begin("Statistics", None, flags)
-        for line in v.stats.lines():
-            imgui.text(line)
-        if not v.timer:
-            imgui.text_colored(GREY, "GPU time: adapter has no timestamp queries")
-        w, h = v.frame_size
-        imgui.text_colored(GREY, f"{w}x{h} px, vsync {'on' if v.vsync else 'off'}")
-        imgui.text_colored(GREY, v.gpu.summary.split(" (")[0] + " " + v.gpu.summary.rsplit(" via ", 1)[-1])
-        imgui.text_colored(GREY, "C resets, X hides")
+        imgui.begin("Statistics", None, flags | (imgui.WindowFlags_.no_title_bar if self.compact else 0))
+        if self.compact:
+            imgui.text(f"FPS {v.stats.fps or 0:.1f}")
+            imgui.text(f"{v.stats.frame_ms or 0:.1f} ms" + (f", GPU {v.stats.gpu_time_ms:.2f}" if v.stats.gpu_ms else ""))
+        else:
+            for line in v.stats.lines():
+                imgui.text(line)
+            if not v.timer:
+                imgui.text_colored(GREY, "GPU time: adapter has no timestamp queries")
+            w, h = v.frame_size
+            imgui.text_colored(GREY, f"{w}x{h} px, vsync {'on' if v.vsync else 'off'}")
+            imgui.text_colored(GREY, v.gpu.summary.split(" (")[0] + " " + v.gpu.summary.rsplit(" via ", 1)[-1])
+            imgui.text_colored(GREY, "C resets, X hides")
+        self._record("stats")
         imgui.end()
-        self.drawn_panels.append("stats")
 
     def _params(self, technique_name: str, tag: str) -> None:
         v = self.viewer
@@ -128,10 +147,19 @@ class Hud:
 
     def _info_panel(self, flags, width) -> None:
         v = self.viewer
-        imgui.set_next_window_pos((width - 10, 10), imgui.Cond_.first_use_ever, (1.0, 0.0))
-        imgui.set_next_window_size((min(340, width / 2), 0), imgui.Cond_.first_use_ever)
+        if self.compact:  # beside the statistics, collapsed to its title (click to open)
+            imgui.set_next_window_pos((width - MARGIN, MARGIN), imgui.Cond_.always, (1.0, 0.0))
+            imgui.set_next_window_size((width / 2 - 1.5 * MARGIN, 0), imgui.Cond_.always)
+            imgui.set_next_window_collapsed(True, imgui.Cond_.first_use_ever)
+        else:
+            imgui.set_next_window_pos((width - MARGIN, MARGIN), imgui.Cond_.first_use_ever, (1.0, 0.0))
+            imgui.set_next_window_size((min(340, width / 2), 0), imgui.Cond_.first_use_ever)
         imgui.set_next_window_bg_alpha(0.6)
-        imgui.begin("Technique", None, imgui.WindowFlags_.no_focus_on_appearing)
+        title = f"{v.key_for(v.technique)} {v.technique}" + (f" | {v.technique_b}" if v.split else "")
+        if not imgui.begin(f"{title}###Technique", None, imgui.WindowFlags_.no_focus_on_appearing)[0]:
+            self._record("info")  # collapsed: the title bar alone
+            imgui.end()
+            return
         imgui.push_item_width(-140)
         sides = [("A", v.technique)] + ([("B", v.technique_b)] if v.split else [])
         for tag, name in sides:
@@ -164,8 +192,8 @@ class Hud:
         if changed:
             v.set_vsync(vsync)
         imgui.pop_item_width()
+        self._record("info")
         imgui.end()
-        self.drawn_panels.append("info")
 
     def _help_panel(self, flags, width, height) -> None:
         imgui.set_next_window_pos((width / 2, height / 2), imgui.Cond_.appearing, (0.5, 0.5))
@@ -175,8 +203,8 @@ class Hud:
             imgui.text_colored(YELLOW, f"{control.label:<14}")
             imgui.same_line(130)
             imgui.text(control.help)
+        self._record("help")
         imgui.end()
-        self.drawn_panels.append("help")
 
     def _legend(self, width, height) -> None:
         v = self.viewer
@@ -223,17 +251,28 @@ class Hud:
             draw.add_text(pos, yellow if tag == v.active_side else white, text)
         self.drawn_panels.append("split")
 
-    def _status(self, flags, height) -> None:
+    def _status(self, flags, width, height) -> None:
         v = self.viewer
         lines = [(RED, e) for e in v.reloader.errors] if v.reloader else []
+        problem = v.current_problem()
+        if problem:
+            lines.append((RED, problem))
+        if v.build is not None:
+            lines.append((YELLOW, v.build.line()))
+            self.drawn_panels.append("progress")
         lines += [(WHITE, m) for m in v.messages[-3:]]
         if not lines:
             return
-        imgui.set_next_window_pos((10, height - (110 if v.split else 80)), imgui.Cond_.always, (0.0, 1.0))
+        below = v.split or v.mode in ("cost", "error")  # the legend and the A/B labels sit at the bottom
+        bottom = height - (MARGIN if self.compact and not below else 110 if v.split else 80)
+        imgui.set_next_window_pos((MARGIN, bottom), imgui.Cond_.always, (0.0, 1.0))
+        imgui.set_next_window_size_constraints((0, 0), (max(width - 2 * MARGIN, 60), height / 2))
         imgui.set_next_window_bg_alpha(0.7)
         imgui.begin("Status", None, flags | imgui.WindowFlags_.no_title_bar)
+        imgui.push_text_wrap_pos(max(width - 40, 40))  # long paths wrap instead of leaving the screen
         for colour, text in lines:
             imgui.text_colored(colour, text)
+        imgui.pop_text_wrap_pos()
+        self._record("status")
         imgui.end()
-        self.drawn_panels.append("status")
 

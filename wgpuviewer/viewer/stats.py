@@ -86,6 +86,10 @@ class FrameStats:
         return out
 
 
+#: Bytes between the slots of the resolve buffer: WebGPU's query resolve offset alignment.
+RESOLVE_STRIDE = 256
+
+
 class GpuTimer:
     """GPU time of the scene passes from 'timestamp-query'.
 
@@ -99,8 +103,10 @@ class GpuTimer:
         self.device = device
         self.slots = slots
         self.query_set = device.create_query_set(label="gpu-timer", type="timestamp", count=2 * slots)
+        # Each slot resolves at its own multiple of 256 bytes (QUERY_RESOLVE_BUFFER_ALIGNMENT).
         self.resolve = device.create_buffer(
-            label="gpu-timer:resolve", size=16 * slots, usage=wgpu.BufferUsage.QUERY_RESOLVE | wgpu.BufferUsage.COPY_SRC
+            label="gpu-timer:resolve", size=RESOLVE_STRIDE * slots,
+            usage=wgpu.BufferUsage.QUERY_RESOLVE | wgpu.BufferUsage.COPY_SRC,
         )
         self.readback = [
             device.create_buffer(
@@ -136,8 +142,8 @@ class GpuTimer:
         if self._current is None:
             return
         i = self._current
-        encoder.resolve_query_set(self.query_set, 2 * i, 2, self.resolve, 16 * i)
-        encoder.copy_buffer_to_buffer(self.resolve, 16 * i, self.readback[i], 0, 16)
+        encoder.resolve_query_set(self.query_set, 2 * i, 2, self.resolve, RESOLVE_STRIDE * i)
+        encoder.copy_buffer_to_buffer(self.resolve, RESOLVE_STRIDE * i, self.readback[i], 0, 16)
 
     def after_submit(self) -> None:
         if self._current is None:

@@ -1,0 +1,149 @@
+"""The one reader's header check (wgpuviewer.core.images.read_header): sizes, emptiness, truncation and folders
+are refused from the first bytes, before any data is loaded, for every format it reads."""
+
+from __future__ import annotations
+
+import struct
+import tracemalloc
+import zlib
+
+import cv2
+import numpy as np
+import pytest
+
+from wgpuviewer.core.errors import FileError
+from wgpuviewer.core.images import MAX_SIDE, read_header, read_height, read_image
+
+HUGE = 60000  # 60000 x 60000 float32 would be 14.4 GB
+
+
+def _chunk(kind: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+
+def huge_png(path, w=HUGE, h=HUGE):
+    ihdr = struct.pack(">IIBBBBB", w, h, 16, 0, 0, 0, 0)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + _chunk(b"IHDR", ihdr) + _chunk(b"IDAT", zlib.compress(b"\0" * 64))
+                     + _chunk(b"IEND", b""))
+    return path
+
+
+def huge_jpeg(path, w=HUGE, h=HUGE):
+    sof = b"\xff\xc0" + struct.pack(">HBHHB", 11, 8, h, w, 1) + bytes([1, 0x11, 0])
+    sos = b"\xff\xda" + struct.pack(">HB", 8, 1) + bytes([1, 0, 0, 63, 0])
+    path.write_bytes(b"\xff\xd8" + sof + sos + b"\0" * 16 + b"\xff\xd9")
+    return path
+
+
+def huge_exr(path, w=HUGE, h=HUGE):
+    def attribute(name: bytes, kind: bytes, value: bytes) -> bytes:
+        return name + b"\0" + kind + b"\0" + struct.pack("<i", len(value)) + value
+
+    path.write_bytes(b"\x76\x2f\x31\x01" + struct.pack("<i", 2)
+                     + attribute(b"channels", b"chlist", b"Y\0" + b"\0" * 16 + b"\0")
+                     + attribute(b"dataWindow", b"box2i", struct.pack("<4i", 0, 0, w - 1, h - 1)) + b"\0" * 65)
+    return path
+
+
+def huge_npy(path, w=HUGE, h=HUGE):
+    with open(path, "wb") as f:
+        np.lib.format.write_array_header_1_0(f, {"descr": "<f4", "fortran_order": False, "shape": (h, w)})
+        f.write(b"\0" * 64)  # the data a real file would have is 14.4 GB
+    return path
+
+
+HUGE_FILES = {"png": huge_png, "jpg": huge_jpeg, "exr": huge_exr, "npy": huge_npy}
+
+
+@pytest.mark.parametrize("ext", list(HUGE_FILES))
+def test_a_file_declaring_a_huge_size_is_refused_before_loading(tmp_path, ext):
+    path = HUGE_FILES[ext](tmp_path / f"huge.{ext}")
+    tracemalloc.start()
+    try:
+        for read in (read_header, read_image, read_height):
+            with pytest.raises(FileError, match=f"{HUGE}x{HUGE} is larger than the limit of {MAX_SIDE} texels"):
+                read(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2 * 2**20, peak  # a few header bytes, not gigabytes
+
+
+def test_sizes_at_the_limit_pass_the_header_check(tmp_path):
+    assert read_header(huge_png(tmp_path / "edge.png", MAX_SIDE, 3)).width == MAX_SIDE
+    with pytest.raises(FileError, match="larger than the limit"):
+        read_header(huge_npy(tmp_path / "over.npy", 3, MAX_SIDE + 1))
+
+
+def write(path, data):
+    assert cv2.imwrite(str(path), data)
+    return path
+
+
+@pytest.fixture
+def good(tmp_path):
+    rng = np.random.default_rng(0)
+    np.save(tmp_path / "g.npy", rng.random((32, 40)).astype(np.float32))
+    return {
+        "png": write(tmp_path / "g.png", rng.integers(0, 255, (32, 40), dtype=np.uint8)),
+        "png16": write(tmp_path / "g16.png", rng.integers(0, 65535, (32, 40, 3), dtype=np.uint16)),
+        "jpg": write(tmp_path / "g.jpg", rng.integers(0, 255, (32, 40, 3), dtype=np.uint8)),
+        "npy": tmp_path / "g.npy",
+    }
+
+
+def test_good_files_headers(good):
+    for name, path in good.items():
+        header = read_header(path)
+        assert (header.width, header.height) == (40, 32), name
+    assert read_header(good["png16"]).channels == 3 and read_header(good["npy"]).format == "npy"
+
+
+@pytest.mark.parametrize("name", ["png", "png16", "jpg", "npy"])
+def test_empty_truncated_and_folder_inputs(good, tmp_path, name):
+    src = good[name]
+    data = src.read_bytes()
+    cases = {
+        "empty": (b"", r"empty file \(0 bytes\)"),
+        "cut": (data[: len(data) // 2], "truncated"),
+        "head": (data[:12], "truncated" if name == "npy" else "damaged or truncated"),
+    }
+    for case, (content, message) in cases.items():
+        path = tmp_path / f"{case}{src.suffix}"
+        path.write_bytes(content)
+        for read in (read_header, read_image, read_height):
+            with pytest.raises(FileError, match=message) as error:
+                read(path)
+            assert str(error.value).startswith(f"{path}: ") and "\n" not in str(error.value)
+    folder = tmp_path / f"folder{src.suffix}"
+    folder.mkdir()
+    with pytest.raises(FileError, match="is a directory"):
+        read_height(folder)
+
+
+def test_unsupported_contents_and_shapes(tmp_path):
+    (tmp_path / "text.png").write_text("hello, not an image")
+    with pytest.raises(FileError, match="cannot decode image"):
+        read_header(tmp_path / "text.png")
+    np.save(tmp_path / "five.npy", np.zeros((4, 4, 5), np.float32))
+    with pytest.raises(FileError, match=r"unsupported shape \(4, 4, 5\)"):
+        read_header(tmp_path / "five.npy")
+    np.save(tmp_path / "obj.npy", np.array([[None]], dtype=object), allow_pickle=True)
+    with pytest.raises(FileError, match="unsupported dtype object"):
+        read_header(tmp_path / "obj.npy")
+    ok = huge_exr(tmp_path / "small.exr", 4, 4)
+    if not cv2.haveImageReader(str(ok)):  # builds without OpenEXR say so, with the fix
+        with pytest.raises(FileError, match="cannot read EXR; convert it"):
+            read_header(ok)
+
+
+def test_nan_policies_report_how_many_texels_they_replaced(tmp_path, caplog):
+    data = np.full((4, 5), 0.5, np.float32)
+    data[0, 0], data[1, 2], data[3, 4] = np.nan, np.inf, -np.inf
+    np.save(tmp_path / "n.npy", data)
+    for policy, what in (("zero", "0"), ("nearest", "the nearest finite value")):
+        caplog.clear()
+        out = read_height(tmp_path / "n.npy", nan_policy=policy)
+        assert np.isfinite(out).all()
+        assert f"n.npy: 3 of 20 texels were NaN/inf; replaced ({policy}: {what})" in caplog.text
+        assert [(r.name, r.levelname) for r in caplog.records] == [("wgpuviewer.images", "WARNING")]

@@ -1,0 +1,180 @@
+"""Batches never read their own outputs, go on past internal errors (exit 3), refuse an empty --kinds; the map
+cache is capped (least recently used maps evicted), shown and cleaned by `maptools cache`, and an unwritable
+cache is a warning, not an error."""
+
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+import pytest
+
+from maptools import cache, cli
+from tests.maptools.helpers import smooth_tileable
+
+
+@pytest.fixture
+def heights(tmp_path):
+    src = tmp_path / "in"
+    src.mkdir()
+    for i in range(3):
+        np.save(src / f"h{i}.npy", smooth_tileable(16, 20, i))
+    return src
+
+
+def batch(*argv) -> int:
+    return cli.main(["batch", *map(str, argv), "--kinds", "normal,complexity", "--backend", "cpu"])
+
+
+def names(folder) -> list[str]:
+    return sorted(p.name for p in folder.rglob("*") if p.is_file())
+
+
+@pytest.mark.parametrize("where", ["inside", "same"])
+def test_outputs_are_never_inputs(heights, where, capsys):
+    out = heights / "maps" if where == "inside" else heights
+    assert batch(heights, "-o", out) == 0
+    first = names(heights)
+    assert batch(heights, "-o", out) == 0  # again: only the three inputs, all up to date
+    assert "0 generated, 6 up to date, 0 failed" in capsys.readouterr().out
+    assert names(heights) == first
+    assert not [n for n in first if n.count(".normal") + n.count(".complexity") > 1]  # no x.normal.normal.png
+    # outputs written elsewhere are recognised by their sidecars when that folder is searched later
+    assert batch(out, heights, "-o", heights / "elsewhere") == 0
+    assert "6 generated, 0 up to date, 0 failed" in capsys.readouterr().out
+
+
+def test_outputs_without_sidecars_in_the_output_folder_are_not_inputs(heights, capsys):
+    assert batch(heights, "-o", heights) == 0
+    for sidecar in heights.glob("*.json"):  # as after a kill between an output and its sidecar
+        sidecar.unlink()
+    assert batch(heights, "-o", heights) == 0
+    assert "6 generated, 0 up to date, 0 failed" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("kinds", ["", ",", " , "])
+def test_an_empty_kinds_list_is_an_error(heights, tmp_path, kinds, capsys):
+    for command in (["batch", str(heights), "-o", str(tmp_path / "o")], ["check", str(heights / "h0.npy")]):
+        assert cli.main([*command, "--kinds", kinds]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"--kinds {kinds!r}: expected a comma-separated list" in err[0]
+    assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
+
+
+def test_an_internal_error_in_one_job_exits_3_and_the_batch_goes_on(heights, tmp_path, monkeypatch, capsys):
+    real = cli.generate
+    traces = tmp_path / "traces"
+    traces.mkdir()
+    monkeypatch.setattr(cli, "save_traceback", lambda prog, error: cli_save(prog, error, traces))
+
+    def generate(kind, height, **kw):
+        if kind == "complexity" and np.array_equal(height, np.load(heights / "h1.npy")):
+            raise TypeError("a bug in one kernel")
+        return real(kind, height, **kw)
+
+    monkeypatch.setattr(cli, "generate", generate)
+    assert batch(heights, "-o", tmp_path / "maps") == 3
+    out = capsys.readouterr().out
+    assert "5 generated, 0 up to date, 1 failed (1 internal error(s): please report them)" in out
+    line = next(row for row in out.splitlines() if "INTERNAL" in row)
+    assert "h1.npy" in line and "TypeError: a bug in one kernel" in line and str(traces) in line
+    assert len(list(traces.iterdir())) == 1
+
+
+def cli_save(prog, error, folder):
+    path = folder / f"{prog}-traceback.txt"
+    path.write_text(f"{type(error).__name__}: {error}")
+    return path
+
+
+@pytest.fixture
+def cache_dir(tmp_path, monkeypatch):
+    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def test_the_cache_evicts_the_least_recently_used_maps_beyond_its_cap(cache_dir, monkeypatch):
+    maps = [smooth_tileable(32, 32, i) for i in range(5)]
+    cache.cached_generate("normal", maps[0], backend="cpu")
+    size = cache.entries()[0].size
+    monkeypatch.setenv(cache.CACHE_MAX_ENV, str(3 * size + size // 2))  # room for three maps
+    for i, h in enumerate(maps[1:3], start=1):
+        cache.cached_generate("normal", h, backend="cpu")
+        old = time.time() - 100 + i
+        os.utime(cache.entries()[-1].path, (old, old))
+    os.utime(cache.entries()[0].path, (time.time() - 1000,) * 2)  # maps[0] is the least recently used ...
+    cache.cached_generate("normal", maps[0], backend="cpu")  # ... until a hit touches it
+    cache.cached_generate("normal", maps[3], backend="cpu")
+    cache.cached_generate("normal", maps[4], backend="cpu")
+    kept = {e.path for e in cache.entries()}
+    assert len(kept) == 3 and sum(e.size for e in cache.entries()) <= 3 * size + size // 2
+    key = {i: cache.cache_path("normal", cache.cache_key("normal", h, cache.get_kind("normal").resolve({})))
+           for i, h in enumerate(maps)}
+    assert kept == {key[0], key[3], key[4]}  # 1 and 2 were the least recently used
+
+
+def test_cache_info_and_clean(cache_dir, capsys):
+    for i in range(3):
+        cache.cached_generate("complexity", smooth_tileable(16, 16, i), backend="cpu")
+    cache.cached_generate("maxmip", smooth_tileable(16, 16, 0), backend="cpu")
+    old = time.time() - 3 * 86400
+    for entry in cache.entries()[:2]:
+        os.utime(entry.path, (old, old))
+    assert cli.main(["cache", "info"]) == 0
+    out = capsys.readouterr().out
+    assert f"map cache: {cache_dir} ($WGPUVIEWER_CACHE_DIR)" in out and "size cap: 2.0 GiB" in out
+    assert "complexity" in out and "maxmip" in out and "total: 4 maps" in out
+    assert cli.main(["cache", "clean", "--older-than", "2d"]) == 0
+    assert "removed 2 maps" in capsys.readouterr().out and len(cache.entries()) == 2
+    (cache_dir / "complexity" / "ab").mkdir(parents=True, exist_ok=True)
+    (cache_dir / "complexity" / "ab" / ".abc.npy.x1.tmp").write_bytes(b"left by a kill")
+    assert cli.main(["cache", "clean"]) == 0
+    assert "removed 2 maps" in capsys.readouterr().out and cache.entries() == []
+    assert not list(cache_dir.rglob("*.tmp"))
+
+
+@pytest.mark.parametrize("argv,env,needle", [
+    (["cache", "clean", "--older-than", "soon"], {}, "--older-than 'soon': expected an age"),
+    (["cache", "info"], {"WGPUVIEWER_CACHE_MAX": "lots"}, "$WGPUVIEWER_CACHE_MAX = 'lots': expected a size"),
+    (["cache", "frobnicate"], {}, "invalid choice: 'frobnicate'"),
+])
+def test_cache_user_errors(cache_dir, monkeypatch, capsys, argv, env, needle):
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0], err
+
+
+def test_an_unwritable_cache_is_a_warning_and_the_map_is_still_made(tmp_path, monkeypatch, caplog):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    monkeypatch.setenv(cache.CACHE_ENV, str(blocker / "maps"))
+    monkeypatch.setattr(cache, "_warned", set())
+    h = smooth_tileable(16, 16, 4)
+    for _ in range(2):
+        got = cache.cached_generate("normal", h, backend="cpu")
+        assert got.shape == (16, 16, 3)
+    warnings = [r.getMessage() for r in caplog.records if r.name == "maptools.cache"]
+    assert len(warnings) == 1, warnings  # once per process
+    assert f"map cache {blocker / 'maps'} cannot be written" in warnings[0]
+    assert "set WGPUVIEWER_CACHE_DIR to a writable folder" in warnings[0]
+    assert blocker.read_text() == "not a folder"
+
+
+def test_render_with_an_unwritable_cache_warns_once_and_renders(tmp_path, monkeypatch, capsys, adapter):
+    from wgpuviewer import cli as wgpuviewer_cli
+    from wgpuviewer import textures
+
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    monkeypatch.setenv(cache.CACHE_ENV, str(blocker / "maps"))
+    monkeypatch.setattr(cache, "_warned", set())
+    textures.clear_cache()
+    out = tmp_path / "x.png"
+    assert wgpuviewer_cli.main(["render", "-o", str(out), "--size", "32x24", "--technique", "pom_adaptive"]) == 0
+    err = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert err == [f"wgpuviewer: warning: map cache {blocker / 'maps'} cannot be written (Not a directory); "
+                   "maps are rebuilt on every run: set WGPUVIEWER_CACHE_DIR to a writable folder"], err
+    assert out.is_file()

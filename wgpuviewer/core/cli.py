@@ -1,0 +1,176 @@
+"""What both command lines (``wgpuviewer`` and ``maptools``) share: preparing the process before any GPU driver
+loads, warnings as one line each, argparse errors as one line, and the exit codes.
+
+Exit codes: 0 success, 1 a check or batch job failed (the commands return it), 2 a user error (``UserError`` or
+``InputError``: one line naming the thing and the fix), 3 an internal error (a bug: a one-line summary, and the
+traceback saved to a file whose path is printed), 130 interrupted.
+
+This module imports only the standard library at import time, so a CLI can call ``prepare_process`` before
+wgpu or OpenCV load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import logging
+import os
+import stat
+import sys
+import tempfile
+import threading
+import time
+import traceback
+from collections.abc import Callable
+from pathlib import Path
+
+from .errors import InputError, UserError
+
+#: Loggers whose warnings the CLIs print as ``PROG: warning: MESSAGE``.
+WARNING_LOGGERS = ("wgpuviewer", "maptools")
+
+
+def _runtime_dir_ok(path: str | None) -> bool:
+    """What Mesa's window-system code accepts as $XDG_RUNTIME_DIR: an absolute folder of ours, mode 0700."""
+    if not path or not os.path.isabs(path):
+        return False
+    try:
+        info = os.stat(path)
+    except OSError:
+        return False
+    return stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid() and stat.S_IMODE(info.st_mode) == 0o700
+
+
+def private_runtime_dir() -> str:
+    """A folder of this user's only (mode 0700) in the temp dir: ``wgpuviewer-runtime-UID``, or a fresh one."""
+    path = os.path.join(tempfile.gettempdir(), f"wgpuviewer-runtime-{os.getuid()}")
+    try:
+        os.mkdir(path, 0o700)
+    except FileExistsError:
+        pass
+    except OSError:
+        return tempfile.mkdtemp(prefix="wgpuviewer-runtime-")
+    return path if _runtime_dir_ok(path) else tempfile.mkdtemp(prefix="wgpuviewer-runtime-")
+
+
+def prepare_process(prog: str) -> None:
+    """Call first in a CLI's ``main``, before any GPU adapter is requested (importing wgpu loads no driver; the
+    first adapter request does):
+
+    - on POSIX, a private ``$XDG_RUNTIME_DIR`` when it is unset or invalid (Mesa prints four
+      ``error: XDG_RUNTIME_DIR is invalid`` lines otherwise);
+    - OpenCV logs errors only (no ``[ WARN:0@...]`` lines; our readers report failures themselves) and reads EXR
+      where the build can;
+    - warnings of the project's loggers print as one line ``PROG: warning: ...`` on stderr.
+    """
+    if os.name == "posix" and not _runtime_dir_ok(os.environ.get("XDG_RUNTIME_DIR")):
+        os.environ["XDG_RUNTIME_DIR"] = private_runtime_dir()
+    os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
+    os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")
+    cv2 = sys.modules.get("cv2")
+    if cv2 is not None:  # already imported (in-process callers): the variable is read at import only
+        cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)
+    _warnings_as_lines(prog)
+
+
+class _WarningLine(logging.Handler):
+    def __init__(self, prog: str):
+        super().__init__(level=logging.WARNING)
+        self.prog = prog
+
+    def emit(self, record):
+        try:
+            kind = "warning" if record.levelno < logging.ERROR else "error"
+            print(f"{self.prog}: {kind}: {record.getMessage()}", file=sys.stderr)
+        except Exception:  # noqa: BLE001 - a broken stderr must not break the command
+            self.handleError(record)
+
+
+def _warnings_as_lines(prog: str) -> None:
+    for name in WARNING_LOGGERS:
+        logger = logging.getLogger(name)
+        logger.handlers = [h for h in logger.handlers if not isinstance(h, _WarningLine)]
+        logger.addHandler(_WarningLine(prog))
+
+
+@contextlib.contextmanager
+def terminal_progress(what: str, delay: float = 1.0):
+    """Yields ``progress(label, done, total)`` feeding a tqdm bar on stderr: shown once the work has taken
+    ``delay`` seconds, only on a terminal, redrawn every half second (its clock runs during one long step, e.g.
+    a 3D distance map), gone when the work ends."""
+    from tqdm import tqdm
+
+    state: dict = {}
+    stop = threading.Event()
+
+    def tick():
+        while not stop.wait(0.5):
+            bar = state.get("bar")
+            if bar is not None and time.monotonic() - state["start"] >= delay:
+                bar.refresh()
+
+    def progress(label: str, done: int, total: int) -> None:
+        if "bar" not in state:
+            state["start"] = time.monotonic()
+            state["bar"] = tqdm(total=total, desc=what, unit="map", file=sys.stderr, delay=delay, disable=None,
+                                leave=False, dynamic_ncols=True)
+            threading.Thread(target=tick, daemon=True).start()
+        bar = state["bar"]
+        bar.total = total
+        bar.set_postfix_str(label, refresh=False)
+        bar.update(done - bar.n)
+
+    try:
+        yield progress
+    finally:
+        stop.set()
+        if "bar" in state:
+            state["bar"].close()
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse with its usage errors as one line, ``PROG: error: MESSAGE; see PROG [COMMAND] --help``, exit 2
+    (the line starts like every other error of the program, also for a subcommand's options)."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog.split()[0]}: error: {message}; see {self.prog} --help\n")
+
+
+def save_traceback(prog: str, error: BaseException) -> Path | None:
+    """The traceback of ``error`` in a new file in the temp dir; None if it cannot be written."""
+    text = "".join(traceback.format_exception(error))
+    header = f"{prog} {' '.join(sys.argv[1:])}\n{time.strftime('%Y-%m-%d %H:%M:%S')}, Python {sys.version.split()[0]}\n\n"
+    try:
+        fd, name = tempfile.mkstemp(prefix=f"{prog}-traceback-", suffix=".txt")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(header + text)
+    except OSError:
+        return None
+    return Path(name)
+
+
+def run_command(prog: str, command: Callable[[], int]) -> int:
+    """Run a CLI command and turn what it raises into the exit codes of the module docstring."""
+    try:
+        return command()
+    except (UserError, InputError) as error:
+        print(f"{prog}: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{prog}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as error:  # noqa: BLE001 - the one place that reports bugs
+        return report_internal_error(prog, error)
+
+
+def report_internal_error(prog: str, error: BaseException) -> int:
+    """One line on stderr for a bug, the traceback saved to a file (or printed when that fails); returns 3."""
+    summary = f"{type(error).__name__}: {error}".splitlines()[0][:300]
+    saved = save_traceback(prog, error)
+    if saved is None:
+        traceback.print_exception(error, file=sys.stderr)
+        where = "the traceback is above"
+    else:
+        where = f"traceback saved to {saved}"
+    print(f"{prog}: internal error: {summary} (a bug; {where}; please report it)", file=sys.stderr)
+    return 3

@@ -1,0 +1,51 @@
+"""Building what a technique needs (texture files, derived maps: a 3D distance map takes a minute) on a worker
+thread while the window keeps drawing the technique shown; the HUD shows the progress line, and a problem (a bad
+texture file) comes back as a message instead of ending the viewer.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+from wgpuviewer.core.cli import save_traceback
+from wgpuviewer.core.errors import InputError, UserError
+
+
+class MapBuild:
+    """``renderer.prepare(technique)`` on a daemon thread for A/B side ``side``; poll ``finished``."""
+
+    def __init__(self, renderer, technique: str, side: str):
+        self.technique, self.side = technique, side
+        self.label, self.done, self.total = "", 0, 0
+        self.error: str | None = None
+        self.started = time.perf_counter()
+        self._thread = threading.Thread(target=self._run, args=(renderer,), name=f"maps:{technique}", daemon=True)
+        self._thread.start()
+
+    def _run(self, renderer) -> None:
+        try:
+            renderer.prepare(self.technique, self._progress)
+        except (UserError, InputError) as error:
+            self.error = str(error)
+        except Exception as error:  # noqa: BLE001 - a bug must not end the viewer; it is reported with its trace
+            saved = save_traceback("wgpuviewer", error)
+            self.error = (f"internal error building {self.technique}: {type(error).__name__}: {error} "
+                          f"(a bug; traceback {f'saved to {saved}' if saved else 'not saved'})")
+
+    def _progress(self, label: str, done: int, total: int) -> None:
+        self.label, self.done, self.total = label, done, total
+
+    @property
+    def finished(self) -> bool:
+        return not self._thread.is_alive()
+
+    def wait(self, timeout: float | None = None) -> bool:
+        self._thread.join(timeout)
+        return self.finished
+
+    def line(self) -> str:
+        """The HUD's progress line, e.g. ``building distance: bricks.distance (3/8), 12 s``."""
+        seconds = time.perf_counter() - self.started
+        step = f"{self.label} ({self.done + 1}/{self.total})" if self.total and self.done < self.total else "…"
+        return f"building {self.technique}: {step}, {seconds:.0f} s"
