@@ -138,7 +138,7 @@ def check_coefficients(coefficients) -> np.ndarray:
     bad = ~np.isfinite(k.ravel())
     if bad.any():
         i = int(np.argmax(bad))
-        raise InputError(f"coefficients: {names[i]} = {k.ravel()[i]!r}; expected finite numbers")
+        raise InputError(f"coefficients: {names[i]} = {float(k.ravel()[i])}; expected finite numbers")
     peak = float(np.abs(k).max())
     if peak == 0.0 or not np.any(k[2]):
         raise InputError("coefficients: the denominator D x + E y + F is identically zero; expected a projective map")
@@ -213,10 +213,13 @@ def build(setup: Setup) -> Quad:
                 hits.append(((t * d - anchor) @ e_u, (t * d - anchor) @ e_v))
                 distances.append(t)
     horizon = len(hits) < 4
-    hits = np.array(hits)
+    hits = np.array(hits or [(0.0, 0.0)])  # no corner sees the wall's front: anchor the texture at the anchor point
+    distances = distances or [1.0]
     unit = 1.0 / setup.texels_per_unit
     lo = hits.min(0) - (setup.offset + MARGIN_TEXELS) * unit
-    hi = hits.max(0) + MARGIN_TEXELS * unit
+    # The far side gets a tenth of the visible extent more: near edge-on, one pixel there spans more than any
+    # margin in texels, and the rasteriser must still cover the frame's last pixel.
+    hi = hits.max(0) + MARGIN_TEXELS * unit + 0.1 * (hits.max(0) - hits.min(0))
     if horizon:  # past the horizon the wall has no far edge in view: any finite extent will do
         hi = np.maximum(hi, lo + 1e3)
     size = hi - lo

@@ -33,6 +33,7 @@ the kernel's arithmetic.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -237,7 +238,8 @@ def fixed_setup(k64: np.ndarray, spans: Spans) -> FixedSetup:
     k = np.asarray(k64, np.float64)
     start = k[:, 0:1] * spans.x0 + k[:, 1:2] * spans.y + k[:, 2:3]
     end = start + k[:, 0:1] * (spans.length - 1)
-    peak = np.maximum(np.abs(start).max(1), np.abs(end).max(1))  # the forms are linear: extremes at the ends
+    # The forms are linear: their extremes are at the ends (one step counts too: a 1-pixel span never takes it).
+    peak = np.maximum.reduce([np.abs(start).max(1), np.abs(end).max(1), np.abs(k[:, 0])])
     exponents = np.array([math.frexp(FIXED_PEAK / p)[1] - 1 if p > 0 else 0 for p in peak])
     scale = np.ldexp(float(FIXED_ONE), exponents)
     starts = np.rint(start * scale[:, None]).astype(np.int32)
@@ -326,9 +328,11 @@ def evaluate(name: str, precision: str, coefficients: np.ndarray, spans: Spans) 
     return method.evaluate(ar, np.asarray(coefficients, np.float64), spans), ar
 
 
-def ops_per_texel(name: str, precision: str | None = None, lengths=(1024, 2048)) -> dict[str, tuple[float, float]]:
-    """Operations per texel and per span of ``name``, by kind, from running it on one span of two lengths:
-    {kind: (per texel, per span)}. Per-polygon work (the k A of the parallel forms) counts as per span."""
+@functools.cache
+def ops_per_texel(name: str, precision: str | None = None, lengths=(256, 512)) -> dict[str, tuple[float, float]]:
+    """Operations per texel and per span of ``name``, by kind, from running it on one span of two lengths
+    (multiples of every k, S and M): {kind: (per texel, per span)}. Per-polygon work (the k A of the parallel
+    forms) counts as per span."""
     method = METHODS[name]
     precision = precision or method.precisions[0]
     k = np.array([[1.0, 0.1, 3.0], [0.2, 1.0, 5.0], [-1e-4, 1e-5, 1.0]])

@@ -152,7 +152,7 @@ def mitigation_answer(rows, length) -> str:
     for m in MITIGATIONS:
         err = _err(rows, "span_length", m, span_length=length)
         t = _first(speed, method=m, span_length=frame[0], spans=frame[1])
-        if not (t and t_incr and err > 0):
+        if not (t and t_incr and err > 0 and t_incr["gpu_ratio"] > 0):
             continue
         gain = base / err
         cost = t["gpu_ratio"] / t_incr["gpu_ratio"]

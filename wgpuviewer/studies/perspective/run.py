@@ -63,7 +63,7 @@ class Suite:
 
 SUITES = {
     "smoke": Suite("smoke", (256, 1920, 3840, 8192), (45.0, 80.0, 89.9, 95.0), (0.0, 1e4, 1e6), rows=4, instances=2,
-                   sweep_span=1920, speed_frames=((1920, 64), (8192, 8)), gpu_repeats=5, cpu_repeats=2,
+                   sweep_span=1920, speed_frames=((1920, 128), (8192, 16)), gpu_repeats=7, cpu_repeats=2,
                    heatmap_frame=(480, 270), relief_techniques=("pom", "maxmip"),
                    relief_magnitudes=(0.0, 1e3, 1e5, 1e7), relief_rays=256, relief_texels=64),
     "full": Suite("full", (64, 128, 256, 512, 1024, 1920, 2560, 3840, 7680, 8192, 16384),
@@ -280,6 +280,10 @@ def run(suite_name: str, out: Path, backend: str | None = None, progress: bool =
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out}: exists and is not a folder; choose a folder")
+    try:  # before minutes of work, not after
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise UserError(f"--out {out}: cannot create the folder ({e.strerror or e}); choose another") from None
     started = datetime.datetime.now(datetime.UTC)
     study = Study(suite, backend, progress)
     configs = ([("span_length", Setup(span_length=n, rows=suite.rows, tilt=SWEEP_TILT)) for n in suite.span_lengths]
@@ -305,7 +309,6 @@ def run(suite_name: str, out: Path, backend: str | None = None, progress: bool =
         relief = tieback.measure(suite.relief_techniques, suite.relief_magnitudes, suite.relief_rays,
                                  suite.relief_texels, backend, progress=bar.update)
     finished = datetime.datetime.now(datetime.UTC)
-    out.mkdir(parents=True, exist_ok=True)
     write_csv(out / "results.csv", COLUMNS, study.rows)
     write_csv(out / "along_span.csv", ALONG_COLUMNS, study.along)
     write_csv(out / "tieback.csv", TIEBACK_COLUMNS, relief)
