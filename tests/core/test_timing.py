@@ -41,6 +41,8 @@ def _recorder(device, groups: int):
 def test_more_work_takes_longer_in_both_timers(gpu, timestamps):
     if timestamps and "timestamp-query" not in gpu.features:
         pytest.skip("the adapter has no timestamp-query")
+    if timestamps and gpu.software:
+        pytest.skip("lavapipe's compute timestamps are unreliable once the device has drawn (core/timing.py)")
     small, large = _recorder(gpu.device, 16), _recorder(gpu.device, 4096)
     t = time_passes(gpu.device, [small, large], 5, timestamps=timestamps)
     assert t.timer == ("timestamp" if timestamps else "wall-net")

@@ -89,6 +89,24 @@ def test_past_the_horizon_the_reference_flags_the_pixels_with_no_texel():
     assert np.isfinite(ref.u).all() and np.isfinite(ref.v).all()
 
 
+@pytest.mark.parametrize("tilt", [89.0, 89.99, 90.0, 92.0, 100.0, 150.0])
+def test_the_span_clip_keeps_only_pixels_with_a_defined_texel(tilt):
+    """Inside the clip every pixel's float64 texel is defined, beyond the guard band nothing is clipped, and a span
+    that sees past the horizon is clipped where it crosses."""
+    rng = np.random.default_rng(int(tilt * 100))
+    quad = g.build(g.Setup(span_length=3000, rows=9, tilt=tilt, offset=1e5))
+    spans = g.Spans(rng.integers(-200, 200, 40), rng.integers(-3, 12, 40), 2500)
+    ref = g.reference(quad.coefficients, spans)
+    kept = g.inside(quad.coefficients, spans)
+    assert not (kept & ~ref.valid).any()
+    wu, wv, q = g.numerators(quad.coefficients, spans)
+    peak = np.abs(q).max(axis=1, keepdims=True)
+    safe = ref.valid & (q > 0.01 * peak) & (np.maximum(np.abs(ref.u), np.abs(ref.v)) < g.UMAX / 4)
+    assert kept[safe].all()
+    if tilt < 89.5:
+        assert kept.all()
+
+
 def test_coefficients_are_normalised_by_a_power_of_two_and_scale_free():
     quad = g.build(g.Setup(span_length=100, rows=3, tilt=60.0))
     k = quad.coefficients

@@ -261,6 +261,48 @@ def numerators(coefficients: np.ndarray, spans: Spans) -> tuple[np.ndarray, np.n
     return tuple(k[i, 0] * x + k[i, 1] * y + k[i, 2] for i in range(3))
 
 
+#: The span clip's guard band on q, in float32 half-ulps of the span's largest term: the rounding bound of a running
+#: sum of L steps (one half-ulp each), the coefficient rounding over the span (as much again) and a few for the start.
+GUARD_STARTS = 8
+
+
+def defined_range(coefficients: np.ndarray, spans: Spans) -> tuple[np.ndarray, np.ndarray]:
+    """Per span, the pixels n in [first, end) that every method computes (float64 span setup, as a rasteriser
+    clips): q >= the guard band (below it no float32 form knows the sign of q) and |u|, |v| <= UMAX / 2. The forms
+    are linear along the span, so each condition holds on an interval of n; outside it pixels are flagged whatever
+    a method computes there. Inside it the float64 texel is defined, so no unflagged pixel is ever undefined."""
+    k = np.asarray(coefficients, np.float64)
+    x0, y = spans.x0.astype(np.float64), spans.y.astype(np.float64)
+    last = spans.length - 1
+    start = k[:, 0:1] * x0 + k[:, 1:2] * y + k[:, 2:3]  # (3, R): each form at n = 0; it grows by k[:, 0] per pixel
+    peak = np.max([np.abs(start[2]), np.abs(start[2] + k[2, 0] * last), np.abs(k[2, 1] * y),
+                   np.full(x0.shape, abs(k[2, 2])), np.abs(k[2, 0] * (np.abs(x0) + last))], axis=0)
+    guard = (2 * spans.length + GUARD_STARTS) * 2.0**-24 * peak
+    half = UMAX / 2
+    # each condition as c0 + c1 n >= 0
+    conditions = [(start[2] - guard, np.full(x0.shape, k[2, 0]))]
+    for i in (0, 1):
+        for sign in (1.0, -1.0):
+            conditions.append((half * start[2] - sign * start[i], np.full(x0.shape, half * k[2, 0] - sign * k[i, 0])))
+    lo, hi = np.zeros(x0.shape), np.full(x0.shape, float(last))
+    for c0, c1 in conditions:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            root = -c0 / c1
+        lo = np.where(c1 > 0, np.maximum(lo, root), lo)
+        hi = np.where(c1 < 0, np.minimum(hi, root), hi)
+        hi = np.where((c1 == 0) & (c0 < 0), -1.0, hi)  # never holds
+    first = np.clip(np.ceil(lo), 0, spans.length).astype(np.int64)
+    end = np.clip(np.floor(hi) + 1, 0, spans.length).astype(np.int64)
+    return first, np.maximum(end, first)
+
+
+def inside(coefficients: np.ndarray, spans: Spans) -> np.ndarray:
+    """(R, L) bool: the pixels of ``defined_range``."""
+    first, end = defined_range(coefficients, spans)
+    n = np.arange(spans.length)
+    return (n >= first[:, None]) & (n < end[:, None])
+
+
 def valid(wu: np.ndarray, wv: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Pixels whose texel is defined: in front of the eye (q > 0) and |u|, |v| <= UMAX. Written so that NaN fails."""
     return (q > 0) & (np.abs(wu) <= UMAX * q) & (np.abs(wv) <= UMAX * q)

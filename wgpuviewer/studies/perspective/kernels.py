@@ -16,7 +16,7 @@ from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu
 from wgpuviewer.core.wgsl import compose
 
-from .geometry import Spans
+from .geometry import Spans, defined_range
 from .methods import METHODS, Method, Result, fixed_setup, split
 
 SOURCE = "studies/perspective/kernels.wgsl"
@@ -48,6 +48,7 @@ def pack_params(method: Method, coefficients: np.ndarray, spans: Spans) -> bytes
 def pack_spans(method: Method, coefficients: np.ndarray, spans: Spans) -> np.ndarray:
     data = np.zeros((spans.count, SPAN_STRIDE // 4), np.int32)
     data[:, 0], data[:, 1] = spans.x0, spans.y
+    data[:, 2], data[:, 3] = defined_range(coefficients, spans)
     if method.kernel == "fixed16_16":
         data[:, 4:7] = fixed_setup(coefficients, spans).starts.T
     return data

@@ -23,8 +23,10 @@ and the mitigations of the incremental form's drift:
 - ``fixed16_16``: int32 16.16 fixed-point sums, each quantity scaled by a power of two to at most 2^14, from
   starts rounded from float64 (the stepping error alone), then u = (w_u / q) times the scales' ratio.
 
-Every method flags the pixels whose texel is not defined (``geometry.valid``: q <= 0, or |u| or |v| beyond
-``UMAX``) and returns 0 there: output is finite everywhere, a flagged pixel is never a silent garbage texel.
+Every method flags the pixels the span setup clips away (``geometry.defined_range``: q within its float32
+rounding of 0, or |u| or |v| beyond ``UMAX`` / 2) and those whose own values fail ``geometry.valid`` (q <= 0, or
+|u| or |v| beyond ``UMAX``), and returns 0 there: output is finite everywhere, and no unflagged pixel lacks a
+defined texel.
 Sums of three terms and the compensation terms (t - s) - y of the Kahan and two-float sums go through
 ``Arith.guard`` (times an opaque 1.0): without it the kernels' compiler reorders or cancels them (lavapipe turns
 ``a x + b y + c`` into ``(a x + c) + b y`` and Kahan's compensation into 0), and the numpy twin would no longer be
@@ -41,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .arith import Arith
-from .geometry import UMAX, Spans, valid
+from .geometry import UMAX, Spans, inside, valid
 
 FIXED_ONE = 65536  # 16.16: one unit is 2^-16
 FIXED_PEAK = 2.0**14  # each fixed-point quantity is scaled to at most this (headroom for the drift)
@@ -54,10 +56,11 @@ class Result:
     flagged: np.ndarray  # (R, L) bool
 
 
-def _divide(ar: Arith, w: np.ndarray) -> Result:
-    """u = w_u / q, v = w_v / q from w = (w_u, w_v, q) of shape (3, R, L), with the flags."""
+def _divide(ar: Arith, w: np.ndarray, clip: np.ndarray) -> Result:
+    """u = w_u / q, v = w_v / q from w = (w_u, w_v, q) of shape (3, R, L), with the flags (``clip``: the pixels
+    the span setup keeps, geometry.inside)."""
     wu, wv, q = w
-    ok = valid(wu, wv, q)
+    ok = valid(wu, wv, q) & clip
     u, v = ar.div(wu, q), ar.div(wv, q)
     zero = ar.cast(0)
     return Result(np.where(ok, u, zero), np.where(ok, v, zero), ~ok)
@@ -99,17 +102,17 @@ def direct(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
     x, y = (ar.cast(c) for c in spans.pixels())
     w = ar.add(ar.guard(ar.add(ar.mul(_full(k[:, 0], spans), x), ar.mul(_full(k[:, 1], spans), y))),
                _full(k[:, 2], spans))
-    return _divide(ar, w)
+    return _divide(ar, w, inside(k64, spans))
 
 
 def span(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
     k = ar.cast(k64)
-    return _divide(ar, _span_form(ar, k, span_start(ar, k, spans), _n(ar, spans)))
+    return _divide(ar, _span_form(ar, k, span_start(ar, k, spans), _n(ar, spans)), inside(k64, spans))
 
 
 def incremental(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
     k = ar.cast(k64)
-    return _divide(ar, ar.running_sum(_steps(span_start(ar, k, spans), k[:, 0], spans.length)))
+    return _divide(ar, ar.running_sum(_steps(span_start(ar, k, spans), k[:, 0], spans.length)), inside(k64, spans))
 
 
 def parallel(threads: int) -> Callable:
@@ -123,7 +126,7 @@ def parallel(threads: int) -> Callable:
         seq[:, :, 0, :] = first
         seq[:, :, 1:, :] = stride[:, None, None, None]
         w = ar.running_sum(seq, axis=2).reshape(3, spans.count, rounds * threads)[:, :, :length]
-        return _divide(ar, w)
+        return _divide(ar, w, inside(k64, spans))
 
     return evaluate
 
@@ -137,7 +140,7 @@ def two_ended(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
     if length > half:
         end = ar.add(start, ar.mul(k[:, 0:1], ar.cast(length - 1)))
         parts.append(ar.running_sum(_steps(end, -k[:, 0], length - half))[..., ::-1])  # w + (-A) == w - A
-    return _divide(ar, np.concatenate(parts, axis=2))
+    return _divide(ar, np.concatenate(parts, axis=2), inside(k64, spans))
 
 
 def anchors(length: int, every: int) -> np.ndarray:
@@ -149,7 +152,7 @@ def subdivided(every: int) -> Callable:
     def evaluate(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
         k = ar.cast(k64)
         at = anchors(spans.length, every)
-        exact = _divide(ar, _span_form(ar, k, span_start(ar, k, spans), _n(ar, spans, at)))
+        exact = _divide(ar, _span_form(ar, k, span_start(ar, k, spans), _n(ar, spans, at)), inside(k64, spans)[:, at])
         if at.size == 1:
             return exact
         n = np.arange(spans.length)
@@ -180,7 +183,7 @@ def reanchor(every: int) -> Callable:
         seq[..., 0] = fresh
         seq[..., 1:] = k[:, 0, None, None, None]
         w = ar.running_sum(seq, axis=3).reshape(3, spans.count, rounds * every)[:, :, :length]
-        return _divide(ar, w)
+        return _divide(ar, w, inside(k64, spans))
 
     return evaluate
 
@@ -198,7 +201,7 @@ def kahan(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
         comp = ar.sub(ar.sub(ar.guard(t), s), y)
         s = t
         w[..., n] = s
-    return _divide(ar, w)
+    return _divide(ar, w, inside(k64, spans))
 
 
 def split(k64: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -222,7 +225,7 @@ def double_single(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
         hi = ar.guard(ar.add(s, e))
         lo = ar.sub(e, ar.sub(hi, s))
         w[..., n] = ar.add(hi, lo)
-    return _divide(ar, w)
+    return _divide(ar, w, inside(k64, spans))
 
 
 @dataclass(frozen=True)
@@ -255,7 +258,7 @@ def fixed16_16(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
     seq[..., 1:] = fx.steps[:, None, None]
     wu, wv, q = ar.cast(ar.int_running_sum(seq))
     u, v = ar.mul(ar.div(wu, q), fx.ratio[0]), ar.mul(ar.div(wv, q), fx.ratio[1])
-    ok = (q > 0) & (np.abs(u) <= UMAX) & (np.abs(v) <= UMAX)
+    ok = (q > 0) & (np.abs(u) <= UMAX) & (np.abs(v) <= UMAX) & inside(k64, spans)
     zero = ar.cast(0)
     return Result(np.where(ok, u, zero), np.where(ok, v, zero), ~ok)
 

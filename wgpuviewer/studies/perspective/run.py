@@ -66,10 +66,12 @@ SUITES = {
                    sweep_span=1920, speed_frames=((1920, 128), (8192, 16)), gpu_repeats=7, cpu_repeats=2,
                    heatmap_frame=(480, 270), relief_techniques=("pom", "maxmip"),
                    relief_magnitudes=(0.0, 1e3, 1e5, 1e7), relief_rays=256, relief_texels=64),
-    "full": Suite("full", (64, 128, 256, 512, 1024, 1920, 2560, 3840, 7680, 8192, 16384),
+    # Powers of two and their neighbours, and lengths between: the drift depends on the increment's low bits.
+    "full": Suite("full", (64, 128, 256, 512, 1000, 1024, 1366, 1920, 2048, 2560, 3000, 3840, 4095, 4096, 5000,
+                           6000, 7680, 8192, 10000, 12000, 16383, 16384),
                   (30.0, 45.0, 60.0, 70.0, 75.0, 80.0, 85.0, 87.0, 89.0, 89.5, 89.9, 90.0, 95.0),
                   (0.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7), rows=16, instances=8, sweep_span=3840,
-                  speed_frames=((3840, 2160), (8192, 64)), gpu_repeats=30, cpu_repeats=5, heatmap_frame=(1920, 1080),
+                  speed_frames=((3840, 2160), (8192, 64)), gpu_repeats=15, cpu_repeats=3, heatmap_frame=(1920, 1080),
                   relief_techniques=("pom", "relief", "maxmip", "cone", "distance"),
                   relief_magnitudes=(0.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7), relief_rays=4096, relief_texels=128),
 }

@@ -25,7 +25,7 @@ struct Params {
 struct Span {
     x0: i32,
     y: i32,
-    pad: vec2i,
+    defined: vec2i,      // the span setup's clip (geometry.defined_range): pixels n in [x, y) are computed
     fixed_start: vec4i,  // fixed16_16: w_u, w_v, q at n = 0 in 16.16 units
 }
 
@@ -53,6 +53,10 @@ fn is_defined(w: vec3f) -> bool {
     return w.z > 0.0 && abs(w.x) <= UMAX * w.z && abs(w.y) <= UMAX * w.z;
 }
 
+fn clipped(s: u32, n: u32) -> bool {
+    return i32(n) < spans[s].defined.x || i32(n) >= spans[s].defined.y;
+}
+
 fn store_uv(s: u32, n: u32, uv: vec2f, flagged: bool) {
     let i = s * P.span_length + n;
     out_uv[i] = select(uv, vec2f(0.0), flagged);
@@ -61,5 +65,5 @@ fn store_uv(s: u32, n: u32, uv: vec2f, flagged: bool) {
 
 // Pixel n of span s from its (w_u, w_v, q): the division, or 0 and a flag where the texel is not defined.
 fn store(s: u32, n: u32, w: vec3f) {
-    store_uv(s, n, vec2f(w.x / w.z, w.y / w.z), !is_defined(w));
+    store_uv(s, n, vec2f(w.x / w.z, w.y / w.z), !is_defined(w) || clipped(s, n));
 }

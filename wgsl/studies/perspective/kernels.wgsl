@@ -102,9 +102,9 @@ struct Anchor {
     flagged: bool,
 }
 
-fn anchor(start: vec3f, n: u32) -> Anchor {
+fn anchor(s: u32, start: vec3f, n: u32) -> Anchor {
     let w = start + P.a.xyz * f32(n);
-    let flagged = !is_defined(w);
+    let flagged = !is_defined(w) || clipped(s, n);
     return Anchor(select(w.xy / w.z, vec2f(0.0), flagged), flagged);
 }
 
@@ -122,13 +122,13 @@ fn subdivided(@builtin(global_invocation_id) gid: vec3u) {
     }
     let start = span_start(s);
     let a = (t % parts) * every;
-    let first = anchor(start, a);
+    let first = anchor(s, start, a);
     if len == 1u {
         store_uv(s, 0u, first.uv, first.flagged);
         return;
     }
     let b = min(a + every, len - 1u);
-    let last = anchor(start, b);
+    let last = anchor(s, start, b);
     let slope = (last.uv - first.uv) / f32(b - a);
     let flagged = first.flagged || last.flagged;
     for (var m = 0u; m < min(b - a, MAX_SPAN); m++) {
@@ -207,7 +207,7 @@ fn fixed16_16(@builtin(global_invocation_id) gid: vec3u) {
     for (var n = 0u; n < span_len(); n++) {
         let f = vec3f(w);
         let uv = vec2f((f.x / f.z) * P.fixed_ratio.x, (f.y / f.z) * P.fixed_ratio.y);
-        store_uv(s, n, uv, !(f.z > 0.0 && abs(uv.x) <= UMAX && abs(uv.y) <= UMAX));
+        store_uv(s, n, uv, !(f.z > 0.0 && abs(uv.x) <= UMAX && abs(uv.y) <= UMAX) || clipped(s, n));
         w = w + P.fixed_step.xyz;
     }
 }
