@@ -1,10 +1,13 @@
 """Atomic file writes: every output of the project (renders, maps, reports, settings, caches) goes through
-``atomic_open``, so a reader never sees a partial file, even after ``kill -9`` or a full disk."""
+``atomic_open``, so a reader never sees a partial file, even after ``kill -9`` or a full disk. ``write_csv`` writes
+the tables of results (benchmark, studies) that way."""
 
 from __future__ import annotations
 
 import contextlib
+import csv
 import glob
+import io
 import os
 import tempfile
 from pathlib import Path
@@ -54,3 +57,18 @@ def remove_stale_temps(path) -> None:
     for tmp in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
         with contextlib.suppress(OSError):
             tmp.unlink()
+
+
+def csv_cell(value) -> str:
+    """A CSV cell: floats with 6 significant digits, everything else as text."""
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
+def write_csv(path, columns, rows) -> None:
+    """``rows`` (dicts with at least ``columns``) as a CSV file with a header, atomically."""
+    text = io.StringIO(newline="")
+    writer = csv.DictWriter(text, fieldnames=list(columns), lineterminator="\n", extrasaction="ignore")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: csv_cell(row[k]) for k in columns})
+    write_bytes(path, text.getvalue().encode("utf-8"))

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import csv
 import datetime
-import io
 import platform
 import sys
 import time
@@ -28,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.io import write_bytes
+from wgpuviewer.core.io import write_csv
 
 from . import tieback
 from .geometry import Quad, Reference, Setup, build, reference
@@ -321,21 +320,6 @@ def run(suite_name: str, out: Path, backend: str | None = None, progress: bool =
     }
     write_outputs(out, study.rows, study.along, relief, heat, meta)
     return study.rows
-
-
-def _text(value) -> str:
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return str(value)
-
-
-def write_csv(path: Path, columns: tuple[str, ...], rows: list[dict]) -> None:
-    text = io.StringIO(newline="")
-    writer = csv.DictWriter(text, fieldnames=columns, lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: _text(row[k]) for k in columns})
-    write_bytes(path, text.getvalue().encode("utf-8"))
 
 
 def read_csv(path: Path) -> list[dict]:
