@@ -80,13 +80,15 @@ def answers(rows: list[dict], suite) -> list[str]:
         incr = _first(here, method="incremental")
         if gpu:
             top = ", ".join(f"`{r['method']}` {_f(r['gpu_ratio'])}×" for r in gpu[:4])
-            out.append(f"**Fastest on the GPU**, {h} spans of {w} pixels: `{gpu[0]['method']}` "
+            spread = float(np.median([r["gpu_spread"] for r in here]))
+            out.append(f"**Fastest on the GPU**, {int(h)} spans of {int(w)} pixels: `{gpu[0]['method']}` "
                        f"({_f(gpu[0]['gpu_ratio'])}× `direct`'s time); the first four: {top}; `incremental` "
                        f"{_f(incr['gpu_ratio'])}×; the rasteriser's whole pass {_f(hw['gpu_ratio'])}× "
-                       f"(it also shades and writes a colour target).")
+                       f"(it also shades and writes a colour target). Single passes spread by {_f(spread * 100, 2)} % "
+                       f"(median interquartile range over median, timer `{here[0]['timer']}`).")
         if cpu:
             top = ", ".join(f"`{r['method']}` {_f(r['cpu_ratio'])}×" for r in cpu[:4])
-            out.append(f"**Fastest on the CPU (numpy)**, same frame: `{cpu[0]['method']}` "
+            out.append(f"**Fastest on the CPU (numpy)**, {int(h)} × {int(w)}: `{cpu[0]['method']}` "
                        f"({_f(cpu[0]['cpu_ratio'])}× `direct`); the first four: {top}; `incremental` "
                        f"{_f(incr['cpu_ratio'])}×.")
 
@@ -118,13 +120,17 @@ def answers(rows: list[dict], suite) -> list[str]:
                f"{', '.join(cuts)}.")
 
     out.append(mitigation_answer(rows, longest))
-    mags = sorted({r["offset_texels"] for r in _select(rows, sweep="magnitude")})
-    if mags:
-        top = mags[-1]
+    measured = [o for o in sorted({r["offset_texels"] for r in _select(rows, sweep="magnitude")})
+                if math.isfinite(_err(rows, "magnitude", "direct", offset_texels=o))]
+    beyond = [o for o in {r["offset_texels"] for r in _select(rows, sweep="magnitude")} if o not in measured]
+    if measured:
+        top = measured[-1]
         parts = ", ".join(f"`{m}` {_f(_err(rows, 'magnitude', m, offset_texels=top))}"
                           for m in ("direct", "incremental", "kahan", "fixed16_16", "hardware"))
         out.append(f"**Large coordinates** (offset {top:g} texels, L = {int(suite.sweep_span)}): max error {parts} texels; "
-                   f"float32's spacing there is {_f(float(np.spacing(np.float32(top))))} texels.")
+                   f"float32's spacing there is {_f(float(np.spacing(np.float32(top))))} texels."
+                   + (f" At offsets {', '.join(f'{o:g}' for o in sorted(beyond))} (beyond 2^23 texels) the span setup "
+                      f"flags every pixel: no fractional bit is left." if beyond else ""))
     return out
 
 
@@ -135,6 +141,7 @@ def rows_tilt(rows) -> str:
 
 def mitigation_answer(rows, length) -> str:
     base = _err(rows, "span_length", "incremental", span_length=length)
+    target = 2 * _err(rows, "span_length", "direct", span_length=length)
     speed = _select(rows, sweep="speed")
     frame = (speed[0]["span_length"], speed[0]["spans"]) if speed else (None, None)
     t_incr = _first(speed, method="incremental", span_length=frame[0], spans=frame[1])
@@ -144,19 +151,20 @@ def mitigation_answer(rows, length) -> str:
         t = _first(speed, method=m, span_length=frame[0], spans=frame[1])
         if not (t and t_incr and err > 0 and t_incr["gpu_ratio"] > 0):
             continue
-        gain = base / err
-        cost = t["gpu_ratio"] / t_incr["gpu_ratio"]
-        extra_ops = (t["adds_per_texel"] + t["muls_per_texel"] + t["guards_per_texel"] + t["int_adds_per_texel"]
-                     - t_incr["adds_per_texel"] - t_incr["muls_per_texel"] - t_incr["guards_per_texel"])
-        scored.append((gain / cost, m, err, gain, cost, extra_ops))
+        extra = sum(t[k] - t_incr[k] for k in ("adds_per_texel", "muls_per_texel", "guards_per_texel",
+                                                "int_adds_per_texel", "divs_per_texel"))
+        scored.append((m, err, base / err, t["gpu_ratio"] / t_incr["gpu_ratio"], extra))
     if not scored:
         return "**Mitigations**: not measured."
-    scored.sort(reverse=True)
-    parts = "; ".join(f"`{m}` {_f(err)} texels ({_f(gain, 2)}× less drift, {_f(cost, 2)}× the GPU time, "
-                      f"{_f(extra, 2)} more ops per texel)" for _, m, err, gain, cost, extra in scored)
-    best = scored[0]
-    return (f"**Mitigations** at L = {int(length)} against `incremental` ({_f(base)} texels): {parts}. Most accuracy "
-            f"per GPU time: `{best[1]}` ({_f(best[0], 2)}× error reduction per unit of time factor).")
+    parts = "; ".join(f"`{m}` {_f(err)} texels ({_f(gain, 2)}× less, {_f(cost, 2)}× the GPU time, "
+                      f"{_f(extra, 2)} more ops per texel)" for m, err, gain, cost, extra in scored)
+    enough = [s for s in scored if s[1] <= target]
+    by_ops = min(enough, key=lambda s: s[4], default=None)
+    by_time = min(enough, key=lambda s: s[3], default=None)
+    verdict = (f"The cheapest back to within 2× of `direct` ({_f(target)} texels): by operations `{by_ops[0]}` "
+               f"({_f(by_ops[4], 2)} more per texel), by GPU time here `{by_time[0]}` ({_f(by_time[3], 2)}×)."
+               if enough else f"None gets back to within 2× of `direct` ({_f(target)} texels).")
+    return f"**Mitigations** at L = {int(length)}, against `incremental` ({_f(base)} texels): {parts}. {verdict}"
 
 
 # --- tables -----------------------------------------------------------------------------------------------------
@@ -179,22 +187,24 @@ def sweep_table(rows, sweep: str, key: str, methods, value="max_err") -> list[st
 def speed_table(rows) -> list[str]:
     speed = _select(rows, sweep="speed")
     frames = list(dict.fromkeys((r["span_length"], r["spans"]) for r in speed))
-    header = ["method", "precision", *(f"GPU × direct, {int(h)}×{int(w)}" for w, h in frames),
-              "CPU × direct", "max error (texels)", "add", "mul", "div", "guard", "int add", "per span",
-              "paper add/mul/div"]
+    header = ["method", "precision", *(f"GPU × direct, {int(h)}×{int(w)} (spread)" for w, h in frames),
+              "CPU × direct", "max error (texels)", "add", "mul", "div", "guard", "int add", "paper add/mul/div"]
     body = []
     for name in [*METHODS, "hardware"]:
         first = _first(speed, method=name, span_length=frames[0][0], spans=frames[0][1])
         if not first:
             continue
-        ratios = [(_first(speed, method=name, span_length=w, spans=h) or {}).get("gpu_ratio", "") for w, h in frames]
+        ratios = []
+        for w, h in frames:
+            r = _first(speed, method=name, span_length=w, spans=h)
+            ratios.append(f"{_f(r['gpu_ratio'])} (±{_f(r['gpu_spread'] * 50, 2)} %)" if r else "–")
         paper = f"{first['paper_adds']:g}/{first['paper_muls']:g}/{first['paper_divs']:g}" \
             if first["paper_adds"] != "" else "–"
         if name in METHODS and METHODS[name].paper_note:
             paper += f" ({METHODS[name].paper_note})"
         body.append([f"`{name}`", first["precision"], *ratios, first["cpu_ratio"], first["max_err"],
                      first["adds_per_texel"], first["muls_per_texel"], first["divs_per_texel"],
-                     first["guards_per_texel"], first["int_adds_per_texel"], first["ops_per_span"], paper])
+                     first["guards_per_texel"], first["int_adds_per_texel"], paper])
     return _table(header, body)
 
 
@@ -460,10 +470,13 @@ def report_text(rows: list[dict], relief: list[dict], meta: dict) -> str:
         "",
         "## Speed and operation counts",
         "",
-        "GPU: median of timestamp-query times per pass over the run's repeats, each method's pass taking turns with "
-        "the others; CPU: median wall time of the numpy form. Operation counts per texel (u and v together) come "
-        "from running the numpy code with counting arithmetic; `guard` is the compiler guard (a multiply by an "
-        "opaque 1.0), `per span` the one-off work per span. The paper counts the shared denominator twice.",
+        "GPU: median time per pass over the run's rounds, every method's pass taking turns with the others "
+        f"(timer `{_select(rows, sweep='speed')[0]['timer'] if _select(rows, sweep='speed') else '–'}`; "
+        "`wall-net` is submit to completion minus an empty pass, `docs/perspective.md` says why); ± is half the "
+        "interquartile range of the single passes over their median. CPU: median wall time of the numpy form. "
+        "Operation counts per texel (u and v together) come from running the numpy code with counting "
+        "arithmetic; `guard` is the compiler guard (a multiply by an opaque 1.0). The paper counts the shared "
+        "denominator twice.",
         "",
         *speed_table(rows),
         "",

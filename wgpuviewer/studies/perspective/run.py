@@ -78,7 +78,7 @@ SUITES = {
 COLUMNS = (
     "suite", "sweep", "method", "family", "precision", "span_length", "spans", "tilt_deg", "offset_texels",
     "coord_max_texels", "max_err", "p99_err", "mean_err", "max_err_px", "flagged_fraction", "undetected",
-    "gpu_max_ulp", "gpu_flag_mismatch", "gpu_ms", "gpu_ratio", "cpu_ms", "cpu_ratio", "adds_per_texel",
+    "gpu_max_ulp", "gpu_flag_mismatch", "gpu_ms", "gpu_ratio", "gpu_spread", "cpu_ms", "cpu_ratio", "adds_per_texel",
     "muls_per_texel", "divs_per_texel", "guards_per_texel", "int_adds_per_texel", "ops_per_span", "paper_adds",
     "paper_muls", "paper_divs", "timer", "adapter",
 )
@@ -233,6 +233,9 @@ class Study:
         timings = time_passes(self.gpu.device, recorders, self.suite.gpu_repeats, warmup=2,
                               timestamps="timestamp-query" in self.gpu.features and not self.gpu.software)
         gpu_ms = dict(zip([*names, HARDWARE], timings.median_ms))
+        # interquartile range of the single passes over their median: how far one pass's time is to be trusted
+        spread = {n: float(np.subtract(*np.percentile(t, [75, 25])) / max(np.median(t), 1e-12))
+                  for n, t in zip([*names, HARDWARE], timings.samples_ms)}
         rows = []
         cpu_ms = {}
         for name in names:
@@ -253,7 +256,7 @@ class Study:
         for row in rows:
             ms = gpu_ms[row["method"]]
             row.update(gpu_ms=ms, gpu_ratio=ms / gpu_ms[DIRECT] if gpu_ms[DIRECT] > 0 else float("nan"),
-                       timer=timings.timer)
+                       gpu_spread=spread[row["method"]], timer=timings.timer)
         return rows
 
     def heatmap(self) -> dict:
