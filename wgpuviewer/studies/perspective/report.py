@@ -108,6 +108,9 @@ def answers(rows: list[dict], suite) -> list[str]:
             err = _err(rows, "span_length", "incremental", span_length=n)
             px = _err(rows, "span_length", "incremental", "max_err_px", span_length=n)
             text += f" At {n} pixels (a {name} row): {_f(err)} texels, {_f(px)} of the pixel's footprint at worst."
+    visible = [n for n in lengths if _err(rows, "span_length", "incremental", "max_err_px", span_length=n) >= 1.0]
+    text += (f" It is a whole pixel's footprint or more (visible) from L = {int(visible[0])}." if visible else
+             f" It stays under a pixel's footprint up to L = {int(lengths[-1])}.")
     out.append(text)
 
     longest = max(n for n in lengths if n <= 8192)
@@ -271,30 +274,37 @@ def _style(name: str) -> dict:
     return {"linestyle": {"paper": "-", "reference": ":", "mitigation": "--"}[family], "marker": "o", "markersize": 3}
 
 
-def plot_sweep(plt, rows, sweep: str, key: str, path: Path, xlabel: str, logx: bool, title: str) -> None:
+VALUE_LABELS = {"max_err": "max texture-coordinate error (texels)",
+                "max_err_px": "max error / the pixel's texel footprint (pixels)"}
+
+
+def plot_sweep(plt, rows, sweep: str, key: str, path: Path, xlabel: str, logx: bool, title: str,
+               values=("max_err",)) -> None:
     groups = [("the paper's forms (float32)", PAPER_F32 + ["hardware"]),
               ("subdivided and mitigations (float32)", ["incremental", *REFERENCE_F32, *MITIGATIONS])]
-    fig, axes = plt.subplots(1, 2, figsize=(13, 4.8), sharey=True)
-    for ax, (label, methods) in zip(axes, groups):
-        for m in methods:
-            pts = sorted((r[key], r["max_err"]) for r in _select(rows, sweep=sweep, method=m, precision=_f32(m))
-                         if isinstance(r["max_err"], float) and r["max_err"] > 0)
-            if pts:
-                ax.plot(*zip(*pts), label=m, **_style(m))
-        ax.set_yscale("log")
-        if logx:
-            ax.set_xscale("log")
-            if key == "span_length":  # label the measured lengths themselves, not powers of ten
-                from matplotlib.ticker import NullFormatter
+    fig, axes = plt.subplots(len(values), 2, figsize=(13, 4.8 * len(values)), sharey="row", squeeze=False)
+    for line, value in zip(axes, values):
+        for ax, (label, methods) in zip(line, groups):
+            for m in methods:
+                pts = sorted((r[key], r[value]) for r in _select(rows, sweep=sweep, method=m, precision=_f32(m))
+                             if isinstance(r[value], float) and r[value] > 0)
+                if pts:
+                    ax.plot(*zip(*pts), label=m, **_style(m))
+            ax.set_yscale("log")
+            if logx:
+                ax.set_xscale("log")
+                if key == "span_length":  # label lengths people know (1080p and 4K rows), not powers of ten
+                    from matplotlib.ticker import NullFormatter
 
-                lengths = sorted({r[key] for r in _select(rows, sweep=sweep)})
-                ax.set_xticks(lengths, [str(int(n)) for n in lengths], rotation=45, fontsize=7)
-                ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.set_xlabel(xlabel)
-        ax.set_title(label)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7, ncol=2)
-    axes[0].set_ylabel("max texture-coordinate error (texels)")
+                    lengths = {r[key] for r in _select(rows, sweep=sweep)}
+                    marks = sorted(lengths & {64, 256, 1024, 1920, 3840, 8192, 16384}) or sorted(lengths)
+                    ax.set_xticks(marks, [str(int(n)) for n in marks], fontsize=8)
+                    ax.xaxis.set_minor_formatter(NullFormatter())
+            ax.set_xlabel(xlabel)
+            ax.set_title(label)
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize=7, ncol=2)
+        line[0].set_ylabel(VALUE_LABELS[value])
     fig.suptitle(title)
     _save(fig, path)
     plt.close(fig)
@@ -393,7 +403,7 @@ def plot_tieback(plt, relief: list[dict], path: Path) -> None:
 PLOTS = {
     "error_vs_span_length.png": "max error against span length (tilt 80°)",
     "error_along_span.png": "where along the span the error builds up",
-    "error_vs_tilt.png": "max error against the far-end angle (90°: edge-on)",
+    "error_vs_tilt.png": "max error against the far-end angle (90°: edge-on), in texels and in pixels",
     "error_vs_magnitude.png": "max error against texture-coordinate offset (heavy tiling)",
     "pareto.png": "error against GPU and CPU cost",
     "drift_heatmap.png": "where the incremental drift lands on a long grazing quad",
@@ -407,7 +417,8 @@ def write_outputs(out: Path, rows: list[dict], along: list[dict], relief: list[d
                True, "Float32 error against span length")
     plot_along(plt, along, out / "error_along_span.png")
     plot_sweep(plt, rows, "tilt", "tilt_deg", out / "error_vs_tilt.png", "angle at the span's far end (degrees)",
-               False, "Float32 error against tilt")
+               False, "Float32 error against tilt: in texels, and in pixels of the footprint there",
+               values=("max_err", "max_err_px"))
     plot_sweep(plt, rows, "magnitude", "coord_max_texels", out / "error_vs_magnitude.png",
                "largest texture coordinate in the frame (texels)", True, "Float32 error against coordinate magnitude")
     plot_pareto(plt, rows, out / "pareto.png")

@@ -138,7 +138,9 @@ class Pooled:
 
 
 class Study:
-    def __init__(self, suite: Suite, backend: str | None, progress: bool):
+    """One run's measurements: the device and kernels, the rows so far, the per-method operation counts."""
+
+    def __init__(self, suite: Suite, backend: str | None):
         from wgpuviewer.core.gpu import get_gpu
 
         from .kernels import kernels_for
@@ -146,7 +148,6 @@ class Study:
         self.suite = suite
         self.gpu = get_gpu(backend, quiet=True)
         self.kernels = kernels_for(self.gpu)
-        self.progress = progress
         self.rows: list[dict] = []
         self.along: list[dict] = []
         self.ops = {(name, p): ops_per_texel(name, p) for name, p in variants()}
@@ -289,7 +290,7 @@ def run(suite_name: str, out: Path, backend: str | None = None, progress: bool =
     except OSError as e:
         raise UserError(f"--out {out}: cannot create the folder ({e.strerror or e}); choose another") from None
     started = datetime.datetime.now(datetime.UTC)
-    study = Study(suite, backend, progress)
+    study = Study(suite, backend)
     configs = ([("span_length", Setup(span_length=n, rows=suite.rows, tilt=SWEEP_TILT)) for n in suite.span_lengths]
                + [("tilt", Setup(span_length=suite.sweep_span, rows=suite.rows, tilt=t)) for t in suite.tilts]
                + [("magnitude", Setup(span_length=suite.sweep_span, rows=suite.rows, tilt=SWEEP_TILT, offset=o))
