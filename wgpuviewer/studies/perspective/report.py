@@ -77,20 +77,20 @@ def answers(rows: list[dict], suite) -> list[str]:
         cpu = sorted((r for r in here if r["method"] in METHODS and isinstance(r["cpu_ratio"], float)),
                      key=lambda r: r["cpu_ratio"])
         hw = _first(here, method="hardware")
-        incr = _first(here, method="incremental")
+        stepping = _first(here, method="incremental")
         if gpu:
             top = ", ".join(f"`{r['method']}` {_f(r['gpu_ratio'])}×" for r in gpu[:4])
             spread = float(np.median([r["gpu_spread"] for r in here]))
             out.append(f"**Fastest on the GPU**, {int(h)} spans of {int(w)} pixels: `{gpu[0]['method']}` "
                        f"({_f(gpu[0]['gpu_ratio'])}× `direct`'s time); the first four: {top}; `incremental` "
-                       f"{_f(incr['gpu_ratio'])}×; the rasteriser's whole pass {_f(hw['gpu_ratio'])}× "
+                       f"{_f(stepping['gpu_ratio'])}×; the rasteriser's whole pass {_f(hw['gpu_ratio'])}× "
                        f"(it also shades and writes a colour target). Single passes spread by {_f(spread * 100, 2)} % "
                        f"(median interquartile range over median, timer `{here[0]['timer']}`).")
         if cpu:
             top = ", ".join(f"`{r['method']}` {_f(r['cpu_ratio'])}×" for r in cpu[:4])
             out.append(f"**Fastest on the CPU (numpy)**, {int(h)} × {int(w)}: `{cpu[0]['method']}` "
                        f"({_f(cpu[0]['cpu_ratio'])}× `direct`); the first four: {top}; `incremental` "
-                       f"{_f(incr['cpu_ratio'])}×.")
+                       f"{_f(stepping['cpu_ratio'])}×.")
 
     lengths = sorted({r["span_length"] for r in _select(rows, sweep="span_length")})
     incr = [_err(rows, "span_length", "incremental", span_length=n) for n in lengths]
