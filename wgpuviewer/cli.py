@@ -201,6 +201,16 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def cmd_perspective(args) -> int:
+    from wgpuviewer.studies.perspective.run import run
+
+    command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["perspective"] else "wgpuviewer perspective"
+    out = Path(args.out)
+    run(args.suite, out, backend=args.backend, progress=not args.quiet, command=command)
+    print(out / "report.md")
+    return 0
+
+
 def cmd_info(args) -> int:
     from wgpuviewer.core.gpu import describe_adapters
 
@@ -267,13 +277,22 @@ def build_parser() -> argparse.ArgumentParser:
                        help="measure nothing: write report.md and plots from these results.csv files into --out")
     bench.set_defaults(func=cmd_bench)
 
+    perspective = sub.add_parser("perspective", help="perspective-correct texturing study (seed 001): speed and "
+                                 "float error of Heckbert's direct, incremental and parallel forms")
+    perspective.add_argument("--out", required=True, help="output folder (results.csv, report.md, *.png)")
+    perspective.add_argument("--suite", choices=("smoke", "full"), default="full",
+                             help="full: every sweep, 4K frames (minutes on a software adapter); smoke: seconds, for CI")
+    perspective.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    perspective.add_argument("--quiet", action="store_true", help="no progress bar")
+    perspective.set_defaults(func=cmd_perspective)
+
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
     info.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     info.set_defaults(func=cmd_info)
     return parser
 
 
-COMMANDS = ("view", "render", "techniques", "accuracy", "bench", "info")
+COMMANDS = ("view", "render", "techniques", "accuracy", "bench", "perspective", "info")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import csv
 import datetime
-import io
 import platform
 import sys
 import tempfile
@@ -29,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
+from wgpuviewer.core import io as core_io
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.io import write_bytes
 from wgpuviewer.relief.techniques import TECHNIQUES, resolve_params
 
 #: Parameter settings per technique name (overrides of the registry defaults). Settings naming a
@@ -271,19 +270,8 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     return [r.values for r in rows]
 
 
-def _fmt_csv(value):
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return value
-
-
 def write_csv(path: Path, rows: list[dict]) -> None:
-    text = io.StringIO(newline="")
-    writer = csv.DictWriter(text, fieldnames=COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: _fmt_csv(row[k]) for k in COLUMNS})
-    write_bytes(path, text.getvalue().encode("utf-8"))
+    core_io.write_csv(path, COLUMNS, rows)
 
 
 def read_csv(path: Path) -> list[dict]:

@@ -1,0 +1,69 @@
+// The perspective study's kernel interface (wgpuviewer/studies/perspective/kernels.py packs it): the polygon's
+// coefficients as three columns over the quantities (w_u, w_v, q), the spans, the outputs, and what every
+// method shares: the per-span constants and the flagged store.
+// Pixel (x0 + n, y) of a span: w = a * x + b * y + c componentwise; u = w.x / w.z, v = w.y / w.z (texels).
+
+// |u| or |v| beyond this has no fractional bits left in f32: the pixel is flagged (geometry.UMAX).
+const UMAX: f32 = 16777216.0;
+// Hard caps of every loop: the longest span (geometry.MAX_SPAN) and the most threads per span.
+const MAX_SPAN: u32 = 16384u;
+const MAX_THREADS: u32 = 32u;
+
+struct Params {
+    a: vec4f,            // A1, A2, D (xyz): the x coefficients
+    b: vec4f,            // B1, B2, E: the y coefficients
+    c: vec4f,            // C1, C2, F: the constants
+    a_lo: vec4f,         // double_single: the f64 x coefficients minus a (their f32 parts)
+    fixed_step: vec4i,   // fixed16_16: the x coefficients in 16.16 units of each quantity's scale
+    fixed_ratio: vec4f,  // fixed16_16: scale(q) / scale(w_u), scale(q) / scale(w_v) (powers of two)
+    span_length: u32,
+    span_count: u32,
+    param: u32,          // k (parallel), S (subdivided) or M (reanchor)
+    one: f32,            // 1.0 from the host: a factor the compiler cannot fold (arith.Arith.guard)
+}
+
+struct Span {
+    x0: i32,
+    y: i32,
+    defined: vec2i,      // the span setup's clip (geometry.defined_range): pixels n in [x, y) are computed
+    fixed_start: vec4i,  // fixed16_16: w_u, w_v, q at n = 0 in 16.16 units
+}
+
+@group(0) @binding(0) var<uniform> P: Params;
+@group(0) @binding(1) var<storage, read> spans: array<Span>;
+@group(0) @binding(2) var<storage, read_write> starts: array<vec4f>;  // per-span constants (span_setup)
+@group(0) @binding(3) var<storage, read_write> out_uv: array<vec2f>;
+@group(0) @binding(4) var<storage, read_write> out_flags: array<u32>;
+
+fn span_len() -> u32 {
+    return min(P.span_length, MAX_SPAN);
+}
+
+// a * x + b * y + c, in that order: the opaque factor P.one keeps the compiler from reassociating the sum.
+fn linear(x: f32, y: f32) -> vec3f {
+    return (P.a.xyz * x + P.b.xyz * y) * P.one + P.c.xyz;
+}
+
+// ut_u, ut_v, ub: the per-span constants a * x0 + b * y + c.
+fn span_start(s: u32) -> vec3f {
+    return linear(f32(spans[s].x0), f32(spans[s].y));
+}
+
+fn is_defined(w: vec3f) -> bool {
+    return w.z > 0.0 && abs(w.x) <= UMAX * w.z && abs(w.y) <= UMAX * w.z;
+}
+
+fn clipped(s: u32, n: u32) -> bool {
+    return i32(n) < spans[s].defined.x || i32(n) >= spans[s].defined.y;
+}
+
+fn store_uv(s: u32, n: u32, uv: vec2f, flagged: bool) {
+    let i = s * P.span_length + n;
+    out_uv[i] = select(uv, vec2f(0.0), flagged);
+    out_flags[i] = select(0u, 1u, flagged);
+}
+
+// Pixel n of span s from its (w_u, w_v, q): the division, or 0 and a flag where the texel is not defined.
+fn store(s: u32, n: u32, w: vec3f) {
+    store_uv(s, n, vec2f(w.x / w.z, w.y / w.z), !is_defined(w) || clipped(s, n));
+}
