@@ -202,6 +202,20 @@ TECHNIQUES: dict[str, Technique] = {
             fixed=(("cone_cos", math.cos(math.radians(REFINED_MAX_ANGLE))),),
         ),
         Technique(
+            "quadmax", "-",
+            "Max-quadtree tracing (maxmip with three changes): the walk starts at level floor(log2(reach in texels)) "
+            "+ top_offset, a node texel holds its four children's maxima (moving to a sibling or back up is free), and "
+            "a 2x2-cell leaf packs its 9 depths (14-bit, rounded towards the top) in one texel, solved exactly per "
+            "cell. Never behind the first hit; early by at most the 6e-5 depth quantisation.",
+            "one atlas texel per quad node read + one per leaf (at most 2 per step)",
+            ("albedo", "normal", "depth", "quadmax"),
+            (
+                Param("top_offset", -2, -8, 8, int, "start level = floor(log2(ray reach in texels)) + this (>= 1)"),
+                Param("max_steps", 1024, 1, 65536, int, "cap on traversal steps (capped rays are flagged)"),
+            ),
+            ray_search=True, fetch_bound=lambda p: 2 * p["max_steps"],
+        ),
+        Technique(
             "cone", "-",
             "Relaxed cone stepping (Policarpo & Oliveira) on maptools' conservative cone map: steps of "
             "(D - t) c / (k + c) that never pass the first hit, then binary search of the bracket (the free end "

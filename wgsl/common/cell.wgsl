@@ -1,4 +1,4 @@
-// The exact solve of one bilinear cell (maxmip, distance; the float64 twin is wgpuviewer/relief/reference.py)
+// The exact solve of one bilinear cell (maxmip, distance, quadmax; the float64 twin is wgpuviewer/relief/reference.py)
 // and where a ray leaves a box of cells.
 // #include "common/depth.wgsl"
 
@@ -36,10 +36,15 @@ fn cell_hit(cell: vec2i, start: vec2f, dir: vec2f, t0: f32, t1: f32) -> f32 {
     let size = vec2f(textureDimensions(depth_tex, 0));
     // Gather order: (umin, vmax), (umax, vmax), (umax, vmin), (umin, vmin).
     let g = textureGather(0, depth_tex, material_sampler, (vec2f(cell) + 1.0) / size);
-    let c00 = g.w;
-    let c10 = g.z;
-    let c01 = g.x;
-    let c11 = g.y;
+    return cell_root(vec4f(g.w, g.z, g.x, g.y), cell, start, dir, t0, t1);
+}
+
+// cell_hit's solve for given corner depths c = (c00, c10, c01, c11) (x = +u, y = +v): no fetch.
+fn cell_root(c: vec4f, cell: vec2i, start: vec2f, dir: vec2f, t0: f32, t1: f32) -> f32 {
+    let c00 = c.x;
+    let c10 = c.y;
+    let c01 = c.z;
+    let c11 = c.w;
     let bx = c10 - c00;
     let cy = c01 - c00;
     let exy = c11 - c10 - c01 + c00;
