@@ -9,6 +9,7 @@ resource it builds, so tests (and curious users) can see exactly what a scene co
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,10 @@ FRAME_SIZE = 64 + 16 + 32 + MAX_LIGHTS * 32
 
 #: Frame.mode values (render.wgsl).
 MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4}
+
+#: Draw configurations whose uniform buffer and bind group are kept per material (the least recently drawn are
+#: dropped): draws with different parameters can share one submit (the A/B split, the benchmark's batched frames).
+MAX_DRAW_GROUPS = 64
 
 #: Formats of the material textures the renderer loads itself (the height-derived ones come from maps.py).
 _MATERIAL_FORMATS = {"albedo": "rgba16float", "normal": "rgba8unorm"}
@@ -72,13 +77,15 @@ class OffscreenImage:
 
 
 class Renderer:
-    def __init__(self, scene: Scene, gpu: Gpu):
+    def __init__(self, scene: Scene, gpu: Gpu, textures: dict | None = None):
+        """``textures``: a dict of material textures to share with other renderers of scenes whose materials of the
+        same name have the same textures (the benchmark's views of one height map); default: this renderer's own."""
         self.scene = scene
         self.gpu = gpu
         self.created: list[str] = []  # GPU resources built, in order: "kind:name"
-        self._textures: dict[tuple[str, str], wgpu.GPUTexture] = {}
+        self._textures: dict[tuple[str, str], wgpu.GPUTexture] = {} if textures is None else textures
         self._pipelines: dict[tuple, wgpu.GPURenderPipeline] = {}
-        self._material_groups: dict[tuple[str, str], tuple[wgpu.GPUBindGroup, wgpu.GPUBuffer]] = {}
+        self._material_groups: OrderedDict[tuple, tuple[wgpu.GPUBindGroup, wgpu.GPUBuffer]] = OrderedDict()
         self._material_layouts: dict[tuple[str, ...], wgpu.GPUBindGroupLayout] = {}
         device = gpu.device
         U = wgpu.BufferUsage
@@ -166,24 +173,30 @@ class Renderer:
             )
         return self._material_layouts[technique.textures]
 
-    def _material_group(self, material_name: str, technique: Technique):
-        key = (material_name, technique.name)
-        if key not in self._material_groups:
-            device = self.gpu.device
-            params = device.create_buffer(
-                label=f"params:{material_name}:{technique.name}",
-                size=trace_params_size(technique),
-                usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST,
-            )
-            entries = [{"binding": PARAMS_BINDING, "resource": {"buffer": params}},
-                       {"binding": SAMPLER_BINDING, "resource": self._sampler}]
-            entries += [
-                {"binding": binding(t), "resource": self.texture(material_name, t).create_view()}
-                for t in technique.textures
-            ]
-            group = device.create_bind_group(layout=self._material_layout(technique), entries=entries)
-            self._material_groups[key] = (group, params)
-        return self._material_groups[key]
+    def _material_group(self, material_name: str, technique: Technique, draw: DrawConfig):
+        """Bind group and uniform buffer of one draw configuration on one material (its own buffer, so draws with
+        other parameters recorded into the same submit keep theirs)."""
+        key = (material_name, draw.technique, draw.params, draw.height_scale)
+        if key in self._material_groups:
+            self._material_groups.move_to_end(key)
+            return self._material_groups[key]
+        device = self.gpu.device
+        params = device.create_buffer(
+            label=f"params:{material_name}:{technique.name}",
+            size=trace_params_size(technique),
+            usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST,
+        )
+        entries = [{"binding": PARAMS_BINDING, "resource": {"buffer": params}},
+                   {"binding": SAMPLER_BINDING, "resource": self._sampler}]
+        entries += [
+            {"binding": binding(t), "resource": self.texture(material_name, t).create_view()}
+            for t in technique.textures
+        ]
+        group = device.create_bind_group(layout=self._material_layout(technique), entries=entries)
+        self._material_groups[key] = (group, params)
+        if len(self._material_groups) > MAX_DRAW_GROUPS:
+            self._material_groups.popitem(last=False)
+        return group, params
 
     def pipeline(self, technique: Technique, formats: tuple[str, ...]) -> wgpu.GPURenderPipeline:
         key = (technique.name, formats)
@@ -283,7 +296,7 @@ class Renderer:
         pipeline = self.pipeline(technique, formats)
         groups = {}
         for material_name in {m for m, *_ in self._objects}:
-            group, params_buffer = self._material_group(material_name, technique)
+            group, params_buffer = self._material_group(material_name, technique, draw)
             material = self.scene.materials[material_name]
             depth_shape = self.texture(material_name, "depth").size[1::-1] if technique.needs_depth else (1, 1)
             height_scale = material.height_scale if draw.height_scale is None else draw.height_scale
