@@ -20,6 +20,7 @@ from maptools.cache import cached_generate
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 
+from . import autotable
 from .techniques import REFINED_MAX_ANGLE
 
 
@@ -35,6 +36,9 @@ class MapSlot:
     scale_bound: bool = False
     #: WGSL variable (default NAME_tex); slots that are alternatives for one tracer may share it.
     variable: str = ""
+    #: Built by measuring techniques on the depth map: ``build`` then takes the probe function as a fifth
+    #: argument (the renderer and the probe pass ``probe.probe``; this module cannot import it).
+    measured: bool = False
 
     @property
     def wgsl_name(self) -> str:
@@ -157,6 +161,10 @@ def _quadmax(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wg
     return _uint_texture(gpu, quadmax_atlas(depth, levels), label)
 
 
+def _auto_table(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str, probe) -> wgpu.GPUTexture:
+    return autotable.table_texture(gpu, autotable.measure(depth, height_scale, probe), label)
+
+
 def _volume_texture(gpu: Gpu, volume: np.ndarray, label: str) -> wgpu.GPUTexture:
     dz, h, w = volume.shape
     limit = gpu.adapter.limits["max-texture-dimension-3d"]
@@ -225,6 +233,9 @@ MAP_SLOTS: dict[str, MapSlot] = {
                 "relaxed cone ratios (r32float), texels of u per unit t, textureLoad"),
         MapSlot("quadmax", "texture_2d<u32>", _UINT_2D, _quadmax,
                 "max quadtree atlas (rgba32uint): packed 14-bit leaves (level 1), children's maxima (levels >= 2)"),
+        MapSlot("auto_table", _2D, _UNFILTERABLE_2D, _auto_table,
+                "auto's choices (rgba32float, bins x budget levels): candidate, method, parameter, error",
+                scale_bound=True, measured=True),
     )
 }
 

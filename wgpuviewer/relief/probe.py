@@ -121,7 +121,8 @@ def probe(
         label="probe:params", data=pack_trace_params(tech, height_scale, height.shape, values), usage=S.UNIFORM
     )
     depth = 1.0 - height
-    maps = [(n, MAP_SLOTS[n].build(gpu, depth, height_scale, f"probe:{n}")) for n in _derived(tech)]
+    maps = [(n, MAP_SLOTS[n].build(gpu, depth, height_scale, f"probe:{n}", *((probe,) if MAP_SLOTS[n].measured else ())))
+            for n in _derived(tech)]
     mode = wgpu.AddressMode.repeat if address == "repeat" else wgpu.AddressMode.clamp_to_edge
     sampler = device.create_sampler(
         label="probe:sampler", address_mode_u=mode, address_mode_v=mode, mag_filter="linear", min_filter="linear"

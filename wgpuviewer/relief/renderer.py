@@ -22,8 +22,9 @@ from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 from wgpuviewer.scene import Camera, Scene
 
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_entries
+from .probe import probe
 from .shaders import MAX_LIGHTS, compose_technique, pack_trace_params, trace_params_size
-from .techniques import Technique, get_technique, resolve_params
+from .techniques import AUTO_CANDIDATES, Technique, get_technique, resolve_params
 
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
 DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, depth, fetches
@@ -133,7 +134,9 @@ class Renderer:
             label = f"{material_name}.{kind}"
             slot = MAP_SLOTS[kind]
             if slot.derived:
-                self._textures[key] = slot.build(self.gpu, self._depth_data(material), material.height_scale, label)
+                measured = (probe,) if slot.measured else ()  # auto's table: measured with the probe
+                self._textures[key] = slot.build(self.gpu, self._depth_data(material), material.height_scale, label,
+                                                 *measured)
             else:
                 data = self._normal_data(material) * 0.5 + 0.5 if kind == "normal" else textures.load_albedo(material.albedo)
                 self._textures[key] = create_texture(self.gpu, mip_chain(data), _MATERIAL_FORMATS[kind], label)
@@ -360,7 +363,10 @@ class Renderer:
 
 
 def layer_range(params: dict) -> tuple[float, float]:
-    """(lo, hi) of the layers mode's grey (N - lo) / (hi - lo) (render.wgsl's layer_grey gets them in Frame)."""
+    """(lo, hi) of the layers mode's grey (N - lo) / (hi - lo) (render.wgsl's layer_grey gets them in Frame).
+    auto reports its chosen candidate (1-based, cheapest first) instead of a layer count."""
+    if "max_error" in params:
+        return 1.0, float(len(AUTO_CANDIDATES))
     if params.get("max_layers", 0) > 0:
         return float(params.get("min_layers", 0)), float(params["max_layers"])
     return 0.0, float(max(params.get("layers", 0), params.get("linear_steps", 0), 1))

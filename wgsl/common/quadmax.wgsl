@@ -10,14 +10,13 @@
 // The walk is maxmip's (integer cell state, box exits; wgsl/techniques/maxmip.wgsl) with three changes:
 // it starts at level top = floor(log2(ray reach in texels)) + top_offset (at least 1) instead of the root
 // (coarse nodes of a rough map all reach the top of the relief: visiting them buys nothing); the node
-// test reads the parent's texel, kept per level, so going to a sibling or back up costs no fetch; and a
-// leaf is solved with one fetch: the exact quadratic of each of its (at most 3) cells the ray crosses
-// (cell_root), on the quantised depths. A hit of the leaves' surface is never behind the true first hit.
+// test reads the parent's texel, kept (one for even, one for odd levels), so going to a sibling or back up
+// costs no fetch; and a leaf is solved with one fetch: the exact quadratic of each of its (at most 3) cells
+// the ray crosses (cell_root), on the quantised depths. A hit of the leaves' surface is never behind the true first hit.
 // Fetches: one per quad texel read + one per leaf; at most 2 per step.
 // #include "common/cell.wgsl"
 // #include "common/wrap.wgsl"
 
-const QUAD_LEVELS: u32 = 16u;
 // Float32 rounding of the stored maxima (height -> depth): skip only with this much room to spare.
 const QUAD_MARGIN: f32 = 1e-6;
 const LEAF_SCALE: f32 = 16383.0;
@@ -35,15 +34,29 @@ fn leaf_depth(w: vec4u, k: u32) -> f32 {
     return f32(q & 0x3fffu) / LEAF_SCALE;
 }
 
+// The value of the 2x2 quadrant (x: column, y: row of the cell in its leaf) among a, b (top row), c, d.
+fn quadrant(l: vec2i, a: f32, b: f32, c: f32, d: f32) -> f32 {
+    return select(select(a, b, l.x == 1), select(c, d, l.x == 1), l.y == 1);
+}
+
 // First hit inside the leaf [lo, hi) (packed depths w) of the ray start + t * dir, from cell at t0 until
 // it leaves the leaf at t_exit; -1 if none. No fetch: the leaf is already read.
 fn leaf_hit(w: vec4u, lo: vec2i, hi: vec2i, cell0: vec2i, start: vec2f, dir: vec2f, t0: f32, t_exit: f32) -> f32 {
+    let d0 = leaf_depth(w, 0u);
+    let d1 = leaf_depth(w, 1u);
+    let d2 = leaf_depth(w, 2u);
+    let d3 = leaf_depth(w, 3u);
+    let d4 = leaf_depth(w, 4u);
+    let d5 = leaf_depth(w, 5u);
+    let d6 = leaf_depth(w, 6u);
+    let d7 = leaf_depth(w, 7u);
+    let d8 = leaf_depth(w, 8u);
     var cell = cell0;
     var t = t0;
     for (var k = 0u; k < 4u; k++) {  // a segment crosses at most 3 of the 4 cells
         let l = cell - lo;
-        let i = u32(l.x + 3 * l.y);
-        let c = vec4f(leaf_depth(w, i), leaf_depth(w, i + 1u), leaf_depth(w, i + 3u), leaf_depth(w, i + 4u));
+        let c = vec4f(quadrant(l, d0, d1, d3, d4), quadrant(l, d1, d2, d4, d5),
+                      quadrant(l, d3, d4, d6, d7), quadrant(l, d4, d5, d7, d8));
         let exits = box_exit(start, dir, vec2f(cell), vec2f(cell) + 1.0);
         let t1 = min(min(exits.x, exits.y), t_exit);
         let t_hit = cell_root(c, cell, start, dir, t, t1);
@@ -63,28 +76,31 @@ fn leaf_hit(w: vec4u, lo: vec2i, hi: vec2i, cell0: vec2i, start: vec2f, dir: vec
     return -1.0;
 }
 
+// Atlas row of node level m >= 1: level 1 (the leaves) first, then the levels of ceil(rows / 2^k) rows.
+fn quad_row(rows: i32, m: u32) -> i32 {
+    var row = 0;
+    for (var k = 1u; k < min(m, 31u); k++) {
+        row += (rows + (1 << k) - 1) >> k;
+    }
+    return row;
+}
+
 fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> TraceResult {
     let wh = vec2i(textureDimensions(depth_tex, 0));
-    // Atlas row of each level >= 1; sizes ceil-halve from ceil(wh / 2) at level 1 down to 1x1.
-    var rows: array<i32, QUAD_LEVELS>;
-    var lw = (wh + 1) / 2;
-    var levels = 2u;
-    while (lw.x > 1 || lw.y > 1) && levels < QUAD_LEVELS {
-        rows[levels] = rows[levels - 1u] + lw.y;
-        lw = (lw + 1) / 2;
-        levels += 1u;
-    }
+    // The root: the first level (>= 1) of one node (sizes ceil-halve: level m has ceil(W / 2^m) columns).
+    let root = max(1u, 32u - countLeadingZeros(u32(max(wh.x, wh.y) - 1)));
     let span = parallax_span(v);
     let size = vec2f(wh);
     let start = uv0 * size - 0.5;
     let dir = -span * size;  // texel coordinates per unit t
-    let top = u32(clamp(floor(log2(max(length(dir), 1.0))) + top_offset, 1.0, f32(levels - 1u)));
-    // Per level: the quad texel read last (the node whose children's maxima it holds).
-    var quad_node: array<vec2i, QUAD_LEVELS>;
-    var quad_max: array<vec4f, QUAD_LEVELS>;
-    for (var k = 0u; k < QUAD_LEVELS; k++) {
-        quad_node[k] = vec2i(-1);
-    }
+    let top = u32(clamp(floor(log2(max(length(dir), 1.0))) + top_offset, 1.0, f32(root)));
+    // The quad texels read last, one for the even and one for the odd levels (the walk tests a node with its
+    // parent's texel and moves between neighbouring levels: two slots keep nearly every reuse).
+    // (tagged with the level: nodes of two levels may have the same coordinates).
+    var even_node = vec3i(-1);
+    var even_max = vec4f(0.0);
+    var odd_node = vec3i(-1);
+    var odd_max = vec4f(0.0);
     var cell = vec2i(floor(start));
     var t = 0.0;
     var level = top;
@@ -100,15 +116,26 @@ fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> Trac
         // leaves-only walks, top = 1, read the leaves directly).
         var reach = true;
         let up = level + 1u;
-        if up < levels && top > 1u {
+        if up <= root && top > 1u {
             let parent = node >> vec2u(1u);
-            if any(quad_node[up] != parent) {
+            let tag = vec3i(parent, i32(up));
+            let odd = (up & 1u) == 1u;
+            if any(select(even_node, odd_node, odd) != tag) {
                 fetch_count += 1u;
-                quad_node[up] = parent;
-                quad_max[up] = bitcast<vec4f>(textureLoad(quadmax_tex, vec2i(parent.x, rows[up] + parent.y), 0));
+                let quad = bitcast<vec4f>(textureLoad(quadmax_tex, vec2i(parent.x, quad_row(wh.y, up) + parent.y), 0));
+                if odd {
+                    odd_node = tag;
+                    odd_max = quad;
+                } else {
+                    even_node = tag;
+                    even_max = quad;
+                }
             }
+            let maxima = select(even_max, odd_max, odd);
             let child = node & vec2i(1);
-            reach = t_exit >= 1.0 - quad_max[up][child.x + 2 * child.y] - QUAD_MARGIN;
+            let top_height = select(select(maxima.x, maxima.y, child.x == 1), select(maxima.z, maxima.w, child.x == 1),
+                                    child.y == 1);
+            reach = t_exit >= 1.0 - top_height - QUAD_MARGIN;
         }
         if reach {
             if level > 1u {
