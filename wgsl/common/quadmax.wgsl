@@ -59,9 +59,12 @@ fn leaf_hit(w: vec4u, lo: vec2i, hi: vec2i, cell0: vec2i, start: vec2f, dir: vec
                       quadrant(l, d3, d4, d6, d7), quadrant(l, d4, d5, d7, d8));
         let exits = box_exit(start, dir, vec2f(cell), vec2f(cell) + 1.0);
         let t1 = min(min(exits.x, exits.y), t_exit);
-        let t_hit = cell_root(c, cell, start, dir, t, t1);
-        if t_hit >= 0.0 {
-            return t_hit;
+        // The patch is nowhere above its shallowest corner: a ray still above that at t1 misses the cell.
+        if t1 >= min(min(c.x, c.y), min(c.z, c.w)) || t1 >= 1.0 {
+            let t_hit = cell_root(c, cell, start, dir, t, t1);
+            if t_hit >= 0.0 {
+                return t_hit;
+            }
         }
         if t1 >= t_exit {
             break;
@@ -76,13 +79,13 @@ fn leaf_hit(w: vec4u, lo: vec2i, hi: vec2i, cell0: vec2i, start: vec2f, dir: vec
     return -1.0;
 }
 
-// Atlas row of node level m >= 1: level 1 (the leaves) first, then the levels of ceil(rows / 2^k) rows.
+// Atlas row of node level m >= 1: level 1 (the leaves) first, then the levels of ceil(rows / 2^k) rows:
+// sum over k in [1, m) of ceil(rows / 2^k) = floor((rows - 1) / 2^k) + 1, in closed form with
+// sum over k in [1, K] of floor(n / 2^k) = n - popcount(n) - q + popcount(q), q = n >> K.
 fn quad_row(rows: i32, m: u32) -> i32 {
-    var row = 0;
-    for (var k = 1u; k < min(m, 31u); k++) {
-        row += (rows + (1 << k) - 1) >> k;
-    }
-    return row;
+    let n = u32(rows - 1);
+    let q = n >> (m - 1u);
+    return i32(n - countOneBits(n) - q + countOneBits(q) + m - 1u);
 }
 
 fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> TraceResult {
@@ -149,14 +152,16 @@ fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> Trac
                 return TraceResult(uv0 - span * t_hit, t_hit, fetch_count, is_grazing(v), 0u);
             }
         }
-        // Nothing in this node: step into the next one along the ray and look from one level up.
+        // Nothing in this node: step into the next one along the ray. Look from one level up only when that one
+        // is in another parent: this parent was entered because the ray may reach its relief, and still may.
         t = max(t, t_exit);
         let p = floor(start + t * dir);
         cell = vec2i(
             select(clamp(i32(p.x), lo.x, hi.x - 1), select(lo.x - 1, hi.x, dir.x > 0.0), exits.x <= t_exit),
             select(clamp(i32(p.y), lo.y, hi.y - 1), select(lo.y - 1, hi.y, dir.y > 0.0), exits.y <= t_exit),
         );
-        level = min(level + 1u, top);
+        let same_parent = all((wrap_texel(cell, wh) >> vec2u(up)) == (node >> vec2u(1u)));
+        level = select(min(up, top), level, same_parent && level < top);
     }
     return TraceResult(uv0 - span * t, t, fetch_count, true, 0u);
 }
