@@ -40,6 +40,7 @@ SWEEPS: dict[str, tuple[dict, ...]] = {
     "steep": ({"layers": 8}, {"layers": 16}, {"layers": 32}, {"layers": 64}),
     "pom": tuple({"layers": n} for n in (4, 8, 16, 24, 32, 64, 128)),
     "pom_adaptive": ({},),
+    "auto": ({"max_error": 0.25}, {"max_error": 0.5}, {"max_error": 1.0}),
 }
 
 #: The smoke suite's smaller sweeps (still all of Table 4.1's POM layer counts).
@@ -48,6 +49,7 @@ SMOKE_SWEEPS: dict[str, tuple[dict, ...]] = {
     "steep": ({"layers": 16},),
     "pom": tuple({"layers": n} for n in (4, 8, 16, 24, 32, 64)),
     "pom_adaptive": ({},),
+    "auto": ({"max_error": 0.25}, {"max_error": 0.5}),
 }
 
 BASELINE = "basic"
@@ -363,12 +365,21 @@ def write_csv(path: Path, rows: list[dict]) -> None:
     write_bytes(path, text.getvalue().encode("utf-8"))
 
 
+#: Text columns of results.csv (the others are numbers).
+TEXT_COLUMNS = {"suite", "heightmap", "heightmap_size", "technique", "params", "resolution", "adapter", "backend",
+                "timer", "simd_tile"}
+
+
 def read_csv(path: Path) -> list[dict]:
-    """results.csv back as dicts with numbers parsed (for tests and re-reporting)."""
-    numeric = set(COLUMNS) - {"suite", "heightmap", "heightmap_size", "technique", "params", "resolution",
-                              "adapter", "backend", "timer"}
+    """results.csv back as dicts with numbers parsed (for tests and re-reporting). Columns added after a file was
+    written (e.g. fetches_simd in the H100 run) read as NaN (numbers) or "" (text)."""
     with open(path, newline="", encoding="utf-8") as f:
-        return [{k: (float(v) if k in numeric else v) for k, v in row.items()} for row in csv.DictReader(f)]
+        rows = list(csv.DictReader(f))
+    out = []
+    for row in rows:
+        values = {k: (v if k in TEXT_COLUMNS else float(v) if v != "" else float("nan")) for k, v in row.items()}
+        out.append({**{k: "" if k in TEXT_COLUMNS else float("nan") for k in COLUMNS}, **values})
+    return out
 
 
 def rereport(csv_paths: list[Path], out: Path, command: str = "") -> list[dict]:
