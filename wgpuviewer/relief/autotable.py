@@ -2,23 +2,26 @@
 own depth map at the edges of auto's view-angle bins; per bin and error budget the cheapest candidate that meets the
 budget at both edges of the bin is chosen, and the choices go to the GPU as a small texture (``table_texture``).
 
-Measurement (``measure``): at every angle (0 and the bin edges, ``edge_angles``) ``TILES`` screen tiles of 8 x 4 rays
+Measurement (``measure``): at every angle (0 and the bin edges, ``edge_angles``) ``ERROR_RAYS`` independent random rays
+(entry points all over the map, random azimuths) for the error and ``TILES`` screen tiles of 8 x 4 rays for the cost
 (``tile_rays``: a random entry point and azimuth per tile, rays ``TILE_SPACING`` texels apart, like neighbouring
 pixels of a SIMD group); per candidate and angle the p95 and p97.5 UV error (texels) against the float64 exact hit
 (capped rays count as misses), the mean fetches and the SIMD-tile cost (mean over tiles of the tile's largest fetch
-count, ``accuracy.simd_tile_cost``'s definition). A candidate meets budget B in a bin when its p97.5 is within B at
+count, ``accuracy.simd_tile_cost``'s definition) of the tiles. A candidate meets budget B in a bin when its p97.5 is within B at
 both edges (twice the margin the p95 budget asks for: the table's rays are a sample, and a view sees only part of
 the map); its cost there is the larger SIMD-tile cost of the two edges times ``COST_WEIGHTS`` (the time of one of
 its fetches in POM fetches). Where no candidate meets the budget, the most accurate one is used and the table says
 so (its error channel exceeds the budget).
 
 The measurements are cached on disk next to maptools' maps (content hash of the depth map + height scale +
-candidates + rays, ``maptools.cache``'s key and folder; kind ``auto_table``). This module gets the probe from its
-caller (maps.py's slot is "measured": the renderer and the probe pass ``probe.probe``), so it imports neither.
+candidates, their WGSL code, the rays; ``maptools.cache``'s key and folder, kind ``auto_table``). This module gets
+the probe from its caller (maps.py's slot is "measured": the renderer and the probe pass ``probe.probe``), so it
+imports neither.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Callable
 
@@ -27,6 +30,7 @@ import numpy as np
 from maptools.cache import cache_key, cache_path
 from wgpuviewer.core.gpu import Gpu, create_texture
 from wgpuviewer.core.io import atomic_open
+from wgpuviewer.core.wgsl import compose
 
 from .reference import exact_hit, uv_error_texels, view_dir_from_angles
 from .techniques import (
@@ -41,14 +45,17 @@ from .techniques import (
 )
 
 #: Bump when what ``measure`` computes changes (cached tables are then measured again).
-VERSION = 1
-TILES = 16  # screen tiles per angle
+VERSION = 2
+ERROR_RAYS = 1024  # independent random rays per angle for the error
+TILES = 16  # screen tiles per angle for the cost
 TILE = (8, 4)  # rays per tile: across x along the view azimuth, like a SIMD group of 8 x 4 pixels
 TILE_SPACING = 0.75  # texels between neighbouring rays of a tile
 SEED = 13
-#: Time of one fetch of each candidate in POM fetches, for choosing between candidates that meet a budget
-#: (measured on llvmpipe in the smoke suite: a quadmax fetch - a dependent 128-bit load, its unpacking and up to
-#: three quadratic solves - takes about 3 POM fetches; docs/techniques.md).
+#: Time of one SIMD-tile fetch of each candidate in POM fetches, for choosing between candidates that meet a budget.
+#: Measured on llvmpipe (process CPU time of 96x54 to 192x108 frames, brick and bricks at 45 and 80 degrees): a
+#: quadmax fetch - a dependent 128-bit load, its unpacking, up to three quadratic solves - costs 1.9-3.5 POM fetches,
+#: median 3.2 (docs/techniques.md). The H100 run put the exact walks (maxmip, distance) at 6-12 POM fetches per
+#: fetch; a GPU run of the benchmark reports this per technique ("time per SIMD-tile fetch") to recalibrate.
 COST_WEIGHTS = {"basic": 1.0, "parallax": 1.0, "pom": 1.0, "quadmax": 3.0}
 #: Columns of a measurement: p95 and p97.5 UV error (texels), mean fetches, SIMD-tile cost, capped fraction.
 FIELDS = ("err_p95", "err_p975", "fetches_mean", "fetches_simd", "capped")
@@ -91,11 +98,18 @@ def tile_rays(angle_deg: float, shape: tuple[int, int], rng: np.random.Generator
 def _measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndarray:
     rng = np.random.default_rng(SEED)
     angles = edge_angles()
-    rays = [tile_rays(a, depth.shape, rng) for a in angles]
-    uv = np.concatenate([r[0] for r in rays])
-    view = np.concatenate([r[1] for r in rays])
-    ref = exact_hit(depth, uv, view, height_scale)
-    per_angle = TILES * TILE[0] * TILE[1]
+    n_err, n_cost = ERROR_RAYS, TILES * TILE[0] * TILE[1]
+    uv, view = [], []
+    for a in angles:
+        uv.append(rng.random((n_err, 2)))  # error rays: independent, all over the map
+        view.append(view_dir_from_angles(np.full(n_err, a), rng.random(n_err) * 360.0))
+        tiles = tile_rays(a, depth.shape, rng)  # cost rays: SIMD tiles
+        uv.append(tiles[0])
+        view.append(tiles[1])
+    uv, view = np.concatenate(uv), np.concatenate(view)
+    per_angle = n_err + n_cost
+    error_rays = (np.arange(len(uv)) % per_angle) < n_err
+    ref = exact_hit(depth, uv[error_rays], view[error_rays], height_scale)
     out = np.zeros((len(AUTO_CANDIDATES), len(angles), len(FIELDS)))
     height = 1.0 - np.asarray(depth, np.float64)
     for c, (name, params) in enumerate(AUTO_CANDIDATES):
@@ -104,14 +118,24 @@ def _measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndar
             hit_uv, fetches, capped = got.uv.astype(np.float64), got.fetches.astype(np.float64), got.capped
         else:  # basic: the entry point, no fetch
             hit_uv, fetches, capped = uv, np.zeros(len(uv)), np.zeros(len(uv), bool)
-        err = np.where(capped | ~ref.valid, np.inf, uv_error_texels(hit_uv, np.nan_to_num(ref.uv), depth.shape[::-1]))
+        miss = capped[error_rays] | ~ref.valid
+        err = np.where(miss, np.inf, uv_error_texels(hit_uv[error_rays], np.nan_to_num(ref.uv), depth.shape[::-1]))
         for a in range(len(angles)):
-            part = slice(a * per_angle, (a + 1) * per_angle)
-            e, f = err[part], fetches[part]
+            e = err[a * n_err:(a + 1) * n_err]
+            f = fetches[a * per_angle + n_err:(a + 1) * per_angle]
             # the SIMD-tile cost: mean over the tiles of the tile's largest fetch count
-            out[c, a] = (np.percentile(e, 95), np.percentile(e, 97.5), f.mean(),
-                         f.reshape(TILES, -1).max(axis=1).mean(), capped[part].mean())
+            out[c, a] = (np.percentile(e, 95), np.percentile(e, 97.5), f.mean(), f.reshape(TILES, -1).max(axis=1).mean(),
+                         capped[a * per_angle:(a + 1) * per_angle].mean())
     return out
+
+
+def candidates_code() -> str:
+    """Hash of the candidates' WGSL (each technique file with what it includes): a cached table was measured with
+    exactly this code."""
+    h = hashlib.sha256()
+    for name in dict.fromkeys(name for name, _ in AUTO_CANDIDATES):
+        h.update(compose(TECHNIQUES[name].wgsl_file).code.encode())
+    return h.hexdigest()
 
 
 def measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndarray:
@@ -119,7 +143,8 @@ def measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndarr
     cache when it holds them."""
     d = np.ascontiguousarray(depth, np.float32)
     options = {"height_scale": float(height_scale), "candidates": [[n, p] for n, p in AUTO_CANDIDATES],
-               "angles": [float(a) for a in edge_angles()], "tiles": TILES, "tile": list(TILE),
+               "code": candidates_code(),
+               "angles": [float(a) for a in edge_angles()], "error_rays": ERROR_RAYS, "tiles": TILES, "tile": list(TILE),
                "spacing": TILE_SPACING, "seed": SEED, "version": VERSION}
     path = cache_path("auto_table", cache_key("auto_table", d, options))
     if path.is_file():
