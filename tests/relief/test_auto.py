@@ -108,7 +108,7 @@ def test_more_budget_never_costs_more():
     assert (cost[1:][both] <= cost[:-1][both] + 1e-9).all()
     assert met[autotable.budget_level(8.0)].all()  # 8 texels: something always meets it
     lines = autotable.describe(table_of(h), 0.5)
-    assert lines[0].startswith("0.0–") and lines[-1].split(":")[0].endswith("90°")
+    assert lines[0].startswith("0.0-") and lines[-1].split(":")[0].endswith("90°")
 
 
 def test_debug_view_and_registry_entry(gpu):

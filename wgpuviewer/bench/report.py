@@ -381,7 +381,26 @@ def correlation_section(values: list[dict], meta: dict) -> list[str]:
     if meta.get("software"):
         lines.append("On a software adapter the times are CPU times of an emulated GPU: this says which cost predicts "
                      "llvmpipe, not a GPU. Run the full suite on a GPU for that.")
+    per = per_fetch_time(values)
+    if per:
+        pom = per.get("pom")
+        lines += ["", "Time per SIMD-tile fetch (median over the rows with at least one fetch of (time / basic - 1) / "
+                  "SIMD-tile fetches)" + (", also in POM fetches (auto's COST_WEIGHTS come from this)" if pom else "")
+                  + ":", "", "| technique | × basic per fetch |" + (" in POM fetches |" if pom else ""),
+                  "|---|---|" + ("---|" if pom else "")]
+        for technique, value in per.items():
+            lines.append(f"| {technique} | {value:.3f} |" + (f" {value / pom:.2f} |" if pom else ""))
     return lines + [""]
+
+
+def per_fetch_time(values: list[dict]) -> dict:
+    """technique -> median over its rows with fetches of (ratio_to_basic - 1) / fetches_simd."""
+    out = defaultdict(list)
+    for v in values:
+        simd = v.get("fetches_simd", float("nan"))
+        if math.isfinite(simd) and simd >= 1 and math.isfinite(v["ratio_to_basic"]):
+            out[v["technique"]].append((v["ratio_to_basic"] - 1.0) / simd)
+    return {t: float(np.median(xs)) for t, xs in out.items()}
 
 
 def run_section(meta: dict) -> list[str]:

@@ -220,7 +220,7 @@ def describe(table: np.ndarray, max_error: float) -> list[str]:
         hi = f"{edges[end + 1]:.1f}°" if end + 1 < AUTO_BINS else "90°"
         worst = float(choice[b:end + 1, 1].max())
         met = "" if choice[b:end + 1, 3].all() else " (budget not met)"
-        lines.append(f"{lo:.1f}–{hi}: {candidate_label(int(choice[b, 0]))}, p97.5 ≤ {worst:.3g} texel, "
-                     f"cost ≤ {float(choice[b:end + 1, 2].max()):.3g}{met}")
+        lines.append(f"{lo:.1f}-{hi}: {candidate_label(int(choice[b, 0]))}, p97.5 <= {worst:.3g} texel, "
+                     f"cost <= {float(choice[b:end + 1, 2].max()):.3g}{met}")
         b = end + 1
     return lines

@@ -21,6 +21,7 @@ from wgpuviewer import meshes, textures
 from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 from wgpuviewer.scene import Camera, Scene
 
+from . import autotable
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_entries
 from .probe import probe
 from .shaders import MAX_LIGHTS, compose_technique, pack_trace_params, trace_params_size
@@ -142,6 +143,11 @@ class Renderer:
                 self._textures[key] = create_texture(self.gpu, mip_chain(data), _MATERIAL_FORMATS[kind], label)
             self.created.append(f"texture:{label}")
         return self._textures[key]
+
+    def auto_table(self, material_name: str) -> np.ndarray:
+        """auto's measurements on a material (relief/autotable.py): from the disk cache once auto has drawn it."""
+        material = self.scene.materials[material_name]
+        return autotable.measure(self._depth_data(material), material.height_scale, probe)
 
     @staticmethod
     def _depth_data(material) -> np.ndarray:
