@@ -24,6 +24,7 @@ import io
 import platform
 import sys
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -76,7 +77,8 @@ class Suite:
 SUITES = {
     "smoke": Suite("smoke", ("brick", "bricks", "spike"), (0.0, 45.0, 60.0, 80.0, 89.0), (96, 54), 30, 3,
                    SMOKE_SWEEPS, eval_pixels=1500, builtin_size=128),
-    "full": Suite("full", REAL_MAPS + SYNTHETIC_MAPS, ALL_ANGLES, (1920, 1080), 50, 5, SWEEPS,
+    # 20 frames after 2 warm-up rounds: the whole suite in one 8-minute run on an H100-class GPU (docs/benchmarks.md)
+    "full": Suite("full", REAL_MAPS + SYNTHETIC_MAPS, ALL_ANGLES, (1920, 1080), 20, 2, SWEEPS,
                   eval_pixels=32768, builtin_size=256, reference_workers=-1),
 }
 
@@ -222,14 +224,49 @@ def _fetch_stats(capture, tile) -> dict:
 
     raw = capture.data[:, :, 3]
     covered = capture.covered
-    image = np.where(raw < 0, -raw - 1.0, raw)
-    counts = np.bincount(np.rint(image[covered]).astype(np.int64)) if covered.any() else np.zeros(1, np.int64)
+    capped = raw < 0
+    image = np.where(capped, -raw - 1.0, raw) if capped.any() else raw  # fetch counts: whole numbers
+    counted = image if covered.all() else image[covered]
+    counts = np.bincount(counted.astype(np.int32).ravel()) if counted.size else np.zeros(1, np.int64)
     n = int(counts.sum())
-    mean = float((counts * np.arange(len(counts))).sum() / n) if n else float("nan")
+    mean = float(counts @ np.arange(len(counts)) / n) if n else float("nan")
+    n_capped = int(np.count_nonzero(capped & covered))
     return {"fetches_mean": mean, "fetches_p95": percentile_of_counts(counts, 95),
             "fetches_simd": simd_tile_cost(image, tile, covered),
-            "capped_fraction": float((raw[covered] < 0).mean()) if n else float("nan"),
+            "capped_fraction": n_capped / n if n else float("nan"),
             "covered_fraction": float(covered.mean())}
+
+
+def _view_rows(suite, heightmap, view, configs, timing, captures, sizes, pending_reference, adapter_backend):
+    """The CSV rows of one view from its timing and captures (errors against the view's reference)."""
+    from .view import Shader, errors
+
+    adapter, backend = adapter_backend
+    ref = pending_reference.result()
+    shader = Shader(view)
+    size = view.size
+    basic_ms = timing.results[0].median_ms
+    rows = []
+    for (name, params), t, cap in zip(configs, timing.results, captures):
+        err = errors(view, ref, cap.data, cap.covered, shader)
+        e = err.uv_texels
+        rows.append(Row({
+            "suite": suite.name, "heightmap": heightmap.name,
+            "heightmap_size": f"{heightmap.size[0]}x{heightmap.size[1]}",
+            "technique": name, "params": params_label(params), "angle": view.angle,
+            "angle_min": round(view.angle_min, 3), "angle_max": round(view.angle_max, 3),
+            "resolution": f"{size[0]}x{size[1]}", "adapter": adapter, "backend": backend,
+            "timer": timing.timer, "frames": suite.frames,
+            "gpu_ms": t.median_ms, "basic_ms": basic_ms,
+            "ratio_to_basic": t.median_ms / basic_ms if basic_ms > 0 else float("nan"),
+            "uv_err_mean": float(e.mean()) if e.size else float("nan"),
+            "uv_err_p95": float(np.percentile(e, 95)) if e.size else float("nan"),
+            "uv_err_max": float(e.max()) if e.size else float("nan"),
+            "psnr_db": err.psnr, "eval_pixels": err.pixels,
+            **_fetch_stats(cap, suite.simd_tile),
+            "simd_tile": f"{suite.simd_tile[0]}x{suite.simd_tile[1]}", "map_bytes": sizes[name],
+        }, e))
+    return rows
 
 
 def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
@@ -239,7 +276,8 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     cache when it holds them; auto's tables measured), so the timed part only draws; (2) the float64 reference
     hits of every view, in a process pool when the suite asks for one (full: on all but one CPU core), while
     (3) the GPU part runs view by view: timing (one submit per round of frames), then every configuration's trace
-    data in batches (one submit and two read-backs per batch)."""
+    data in batches (one submit and two read-backs per batch); a worker thread turns each view's data into rows
+    (fetch statistics, errors against the reference) while the GPU works on the next view."""
     import time
 
     from tqdm import tqdm
@@ -250,7 +288,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     from .capture import capture
     from .report import write_outputs
     from .timing import time_configs
-    from .view import Shader, errors, load_heightmap, make_view, reference_pool
+    from .view import load_heightmap, make_view, reference_pool
 
     suite = options.suite
     gpu = get_gpu(options.backend, quiet=True)
@@ -296,45 +334,35 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
         pending = reference_pool([v for _, views, _, _ in work for v in views], suite.eval_pixels,
                                  suite.reference_workers)
         gpu_s = 0.0
-        for heightmap, views, textures, sizes in work:
-            for view in views:
-                bar.set_postfix_str(f"{heightmap.name} {view.angle:g}°")
-                # (3) the GPU part of this view
-                gpu_clock = time.perf_counter()
-                renderer = Renderer(view.scene, gpu, textures)
-                timing = time_configs(renderer, configs, size, suite.frames, suite.warmup)
-                data = capture(renderer, draws, size)
-                gpu_s += time.perf_counter() - gpu_clock
-                counters["submits"] += timing.submits + data.submits
-                counters["readbacks"] += timing.readbacks + data.readbacks
-                busy.append(timing.busy_fraction)
-                ref = pending.pop(0).result()
-                shader = Shader(view)
-                basic_ms = timing.results[0].median_ms
-                for (name, params), t, cap in zip(configs, timing.results, data.captures):
-                    err = errors(view, ref, cap.data, cap.covered, shader)
-                    e = err.uv_texels
-                    rows.append(Row({
-                        "suite": suite.name, "heightmap": heightmap.name,
-                        "heightmap_size": f"{heightmap.size[0]}x{heightmap.size[1]}",
-                        "technique": name, "params": params_label(params), "angle": view.angle,
-                        "angle_min": round(view.angle_min, 3), "angle_max": round(view.angle_max, 3),
-                        "resolution": f"{size[0]}x{size[1]}", "adapter": adapter, "backend": backend,
-                        "timer": timing.timer, "frames": suite.frames,
-                        "gpu_ms": t.median_ms, "basic_ms": basic_ms,
-                        "ratio_to_basic": t.median_ms / basic_ms if basic_ms > 0 else float("nan"),
-                        "uv_err_mean": float(e.mean()) if e.size else float("nan"),
-                        "uv_err_p95": float(np.percentile(e, 95)) if e.size else float("nan"),
-                        "uv_err_max": float(e.max()) if e.size else float("nan"),
-                        "psnr_db": err.psnr, "eval_pixels": err.pixels,
-                        **_fetch_stats(cap, suite.simd_tile),
-                        "simd_tile": f"{suite.simd_tile[0]}x{suite.simd_tile[1]}", "map_bytes": sizes[name],
-                    }, e))
-                    bar.update()
+        processing: list = []  # one future per view: its rows, built while the GPU works on the next views
+
+        def collect(block: bool):
+            while processing and (block or processing[0].done()):
+                new_rows = processing.pop(0).result()
+                rows.extend(new_rows)
+                bar.update(len(new_rows))
                 write_csv(out / "results.csv", [r.values for r in rows])  # partial results survive a kill
-            textures.clear()  # this height map is done: free its GPU textures
+
+        with ThreadPoolExecutor(max_workers=1) as worker:
+            for heightmap, views, textures, sizes in work:
+                for view in views:
+                    bar.set_postfix_str(f"{heightmap.name} {view.angle:g}°")
+                    # (3) the GPU part of this view
+                    gpu_clock = time.perf_counter()
+                    renderer = Renderer(view.scene, gpu, textures)
+                    timing = time_configs(renderer, configs, size, suite.frames, suite.warmup)
+                    data = capture(renderer, draws, size)
+                    gpu_s += time.perf_counter() - gpu_clock
+                    counters["submits"] += timing.submits + data.submits
+                    counters["readbacks"] += timing.readbacks + data.readbacks
+                    busy.append(timing.busy_fraction)
+                    collect(block=len(processing) >= 2)  # at most two views' data waiting
+                    processing.append(worker.submit(_view_rows, suite, heightmap, view, configs, timing,
+                                                    data.captures, sizes, pending.pop(0), (adapter, backend)))
+                textures.clear()  # this height map is done: free its GPU textures (captures hold no textures)
+            collect(block=True)
         phases["gpu"] = gpu_s
-        phases["references and errors"] = time.perf_counter() - clock - gpu_s
+        phases["references and errors, not overlapped with the GPU part"] = time.perf_counter() - clock - gpu_s
     finished = datetime.datetime.now(datetime.UTC)
     meta = {
         "suite": suite, "adapter": adapter, "backend": backend, "software": gpu.software,
