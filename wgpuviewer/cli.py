@@ -162,9 +162,15 @@ def cmd_bench(args) -> int:
         except UserError as e:
             raise UserError(str(e).replace("--size", "--resolution")) from None
     command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["bench"] else "wgpuviewer bench"
+    simd_tile = None
+    if args.simd_tile:
+        try:
+            simd_tile = parse_size(args.simd_tile)
+        except UserError as e:
+            raise UserError(str(e).replace("--size", "--simd-tile")) from None
     options = resolve_options(args.suite, resolution=resolution, heightmaps=names(args.heightmaps, "--heightmaps"),
                               techniques=names(args.techniques, "--techniques"), angles=angles, frames=args.frames,
-                              backend=args.backend, command=command)
+                              backend=args.backend, command=command, simd_tile=simd_tile)
     out = Path(args.out)
     if args.from_csv:
         from wgpuviewer.bench.run import rereport
@@ -235,6 +241,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 89)")
     bench.add_argument("--frames", type=int, help="timed frames per configuration (median; default: the suite's)")
     bench.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    bench.add_argument("--simd-tile", help="WIDTHxHEIGHT pixels of the SIMD group for the fetches_simd cost (default 8x4)")
     bench.add_argument("--quiet", action="store_true", help="no progress bar")
     bench.add_argument("--from-csv", nargs="+", metavar="CSV",
                        help="measure nothing: write report.md and plots from these results.csv files into --out")

@@ -227,7 +227,7 @@ def test_cli_rejects_bad_options(tmp_path, capsys):
     from wgpuviewer.cli import main
 
     for argv in (["--angles", "90"], ["--heightmaps", "nope"], ["--techniques", "nope"],
-                 ["--resolution", "12"], ["--frames", "0"], ["--angles", "a,b"]):
+                 ["--resolution", "12"], ["--frames", "0"], ["--angles", "a,b"], ["--simd-tile", "8"]):
         assert main(["bench", "--suite", "smoke", "--out", str(tmp_path), *argv]) == 2
         err = capsys.readouterr().err
         assert err.startswith("wgpuviewer: error: --") and "Traceback" not in err

@@ -280,6 +280,10 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
         else:
             lines.append(f"| ≤ {hl['budget']:g} | {_label(hl['config'])} | {_f(hl['ratio'])} | "
                          f"{_f(hl['fetches'], 1)} | {_f(hl['simd'], 1)} | {_f(hl['worst_p95'])} |")
+    if meta["software"]:
+        lines += ["", "**Software adapter: these time ratios are llvmpipe's (CPU time of an emulated GPU). The GPU "
+                  "headline is still to be measured** (the full suite on a GPU, docs/benchmarks.md); the fetch counts "
+                  "are the machine-independent part."]
     tw, th = suite.simd_tile
     lines += ["", f"SIMD-tile fetches: the mean over screen tiles of {tw}x{th} pixels of the tile's largest fetch "
               "count (what a SIMD group of that many lanes pays when its lanes loop until the slowest is done), "

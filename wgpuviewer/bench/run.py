@@ -140,7 +140,7 @@ class Options:
 
 
 def resolve_options(suite_name: str, resolution=None, heightmaps=None, techniques=None, angles=None,
-                    frames=None, backend=None, command="") -> Options:
+                    frames=None, backend=None, command="", simd_tile=None) -> Options:
     """Validated run options (UserError naming the option on bad input)."""
     from wgpuviewer.textures import BUILTINS
 
@@ -150,6 +150,8 @@ def resolve_options(suite_name: str, resolution=None, heightmaps=None, technique
     notes = []
     if resolution is not None:
         suite = replace(suite, resolution=tuple(resolution))
+    if simd_tile is not None:
+        suite = replace(suite, simd_tile=tuple(simd_tile))
     if frames is not None:
         if frames < 1:
             raise UserError(f"--frames {frames}: expected at least 1 (30 or more for a stable median)")
@@ -309,7 +311,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
             tqdm(total=total, desc="bench", unit="row", file=sys.stderr, disable=not progress) as bar:
         # (1) height maps, views and every map the configurations sample
         clock = time.perf_counter()
-        work = []  # (heightmap, views, shared textures, map bytes per technique)
+        work = []  # (heightmap, views, the renderer whose maps and pipelines its views share, map bytes per technique)
         for map_name in suite.heightmaps:
             try:
                 heightmap = load_heightmap(map_name, suite.builtin_size, Path(workdir))
@@ -324,10 +326,9 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
                 except ValueError as e:
                     raise UserError(f"--angles {angle:g}: {e}") from None
             bar.set_postfix_str(f"{map_name}: maps")
-            textures: dict = {}
-            first = Renderer(views[0].scene, gpu, textures)
+            first = Renderer(views[0].scene, gpu)  # the views of this map share its maps and pipelines
             sizes = {name: map_bytes(first, "relief", name) for name in dict.fromkeys(n for n, _ in configs)}
-            work.append((heightmap, views, textures, sizes))
+            work.append((heightmap, views, first, sizes))
         phases["maps"] = time.perf_counter() - clock
         # (2) reference hits, all views at once (a pool works on them while the GPU part runs)
         clock = time.perf_counter()
@@ -344,12 +345,12 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
                 write_csv(out / "results.csv", [r.values for r in rows])  # partial results survive a kill
 
         with ThreadPoolExecutor(max_workers=1) as worker:
-            for heightmap, views, textures, sizes in work:
+            for index, (heightmap, views, first, sizes) in enumerate(work):
                 for view in views:
                     bar.set_postfix_str(f"{heightmap.name} {view.angle:g}°")
                     # (3) the GPU part of this view
                     gpu_clock = time.perf_counter()
-                    renderer = Renderer(view.scene, gpu, textures)
+                    renderer = Renderer(view.scene, gpu, like=first)
                     timing = time_configs(renderer, configs, size, suite.frames, suite.warmup)
                     data = capture(renderer, draws, size)
                     gpu_s += time.perf_counter() - gpu_clock
@@ -359,7 +360,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
                     collect(block=len(processing) >= 2)  # at most two views' data waiting
                     processing.append(worker.submit(_view_rows, suite, heightmap, view, configs, timing,
                                                     data.captures, sizes, pending.pop(0), (adapter, backend)))
-                textures.clear()  # this height map is done: free its GPU textures (captures hold no textures)
+                work[index] = (heightmap, views, None, sizes)  # this height map is done: free its maps and pipelines
             collect(block=True)
         phases["gpu"] = gpu_s
         phases["references and errors, not overlapped with the GPU part"] = time.perf_counter() - clock - gpu_s

@@ -79,32 +79,36 @@ class OffscreenImage:
 
 
 class Renderer:
-    def __init__(self, scene: Scene, gpu: Gpu, textures: dict | None = None):
-        """``textures``: a dict of material textures to share with other renderers of scenes whose materials of the
-        same name have the same textures (the benchmark's views of one height map); default: this renderer's own."""
+    def __init__(self, scene: Scene, gpu: Gpu, like: Renderer | None = None):
+        """``like``: a renderer of a scene with the same materials (the benchmark's views of one height map) whose
+        material textures, bind-group layouts, sampler and pipelines this one shares instead of building its own."""
         self.scene = scene
         self.gpu = gpu
         self.created: list[str] = []  # GPU resources built, in order: "kind:name"
-        self._textures: dict[tuple[str, str], wgpu.GPUTexture] = {} if textures is None else textures
-        self._pipelines: dict[tuple, wgpu.GPURenderPipeline] = {}
         self._material_groups: OrderedDict[tuple, tuple[wgpu.GPUBindGroup, wgpu.GPUBuffer]] = OrderedDict()
-        self._material_layouts: dict[tuple[str, ...], wgpu.GPUBindGroupLayout] = {}
         device = gpu.device
         U = wgpu.BufferUsage
         V, F = wgpu.ShaderStage.VERTEX, wgpu.ShaderStage.FRAGMENT
+        if like is not None:
+            self._textures, self._pipelines, self._material_layouts = like._textures, like._pipelines, like._material_layouts
+            self._frame_layout, self._object_layout, self._sampler = like._frame_layout, like._object_layout, like._sampler
+        else:
+            self._textures: dict[tuple[str, str], wgpu.GPUTexture] = {}
+            self._pipelines: dict[tuple, wgpu.GPURenderPipeline] = {}
+            self._material_layouts: dict[tuple[str, ...], wgpu.GPUBindGroupLayout] = {}
+            self._frame_layout = device.create_bind_group_layout(
+                label="frame", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
+            )
+            self._object_layout = device.create_bind_group_layout(
+                label="object", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
+            )
+            self._sampler = device.create_sampler(
+                label="material", address_mode_u="repeat", address_mode_v="repeat",
+                mag_filter="linear", min_filter="linear", mipmap_filter="linear", max_anisotropy=1,
+            )
         self._frame_buffer = device.create_buffer(label="frame", size=FRAME_SIZE, usage=U.UNIFORM | U.COPY_DST)
-        self._frame_layout = device.create_bind_group_layout(
-            label="frame", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
-        )
         self._frame_group = device.create_bind_group(
             layout=self._frame_layout, entries=[{"binding": 0, "resource": {"buffer": self._frame_buffer}}]
-        )
-        self._object_layout = device.create_bind_group_layout(
-            label="object", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
-        )
-        self._sampler = device.create_sampler(
-            label="material", address_mode_u="repeat", address_mode_v="repeat",
-            mag_filter="linear", min_filter="linear", mipmap_filter="linear", max_anisotropy=1,
         )
         self._objects = [self._build_object(i, obj) for i, obj in enumerate(scene.objects)]
 
