@@ -155,22 +155,19 @@ def cmd_bench(args) -> int:
             angles = [float(x) for x in names(args.angles, "--angles")]
         except ValueError:
             raise UserError(f"--angles {args.angles!r}: expected comma-separated degrees, e.g. 0,45,80") from None
-    resolution = None
-    if args.resolution:
+    def size(text, option):
+        if not text:
+            return None
         try:
-            resolution = parse_size(args.resolution)
+            return parse_size(text)
         except UserError as e:
-            raise UserError(str(e).replace("--size", "--resolution")) from None
+            raise UserError(str(e).replace("--size", option)) from None
+
     command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["bench"] else "wgpuviewer bench"
-    simd_tile = None
-    if args.simd_tile:
-        try:
-            simd_tile = parse_size(args.simd_tile)
-        except UserError as e:
-            raise UserError(str(e).replace("--size", "--simd-tile")) from None
-    options = resolve_options(args.suite, resolution=resolution, heightmaps=names(args.heightmaps, "--heightmaps"),
+    options = resolve_options(args.suite, resolution=size(args.resolution, "--resolution"),
+                              heightmaps=names(args.heightmaps, "--heightmaps"),
                               techniques=names(args.techniques, "--techniques"), angles=angles, frames=args.frames,
-                              backend=args.backend, command=command, simd_tile=simd_tile)
+                              backend=args.backend, command=command, simd_tile=size(args.simd_tile, "--simd-tile"))
     out = Path(args.out)
     if args.from_csv:
         from wgpuviewer.bench.run import rereport

@@ -15,7 +15,6 @@
 // the ray crosses (cell_root), on the quantised depths. A hit of the leaves' surface is never behind the true first hit.
 // Fetches: one per quad texel read + one per leaf; at most 2 per step.
 // #include "common/cell.wgsl"
-// #include "common/wrap.wgsl"
 
 // Float32 rounding of the stored maxima (height -> depth): skip only with this much room to spare.
 const QUAD_MARGIN: f32 = 1e-6;
@@ -108,13 +107,12 @@ fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> Trac
     var t = 0.0;
     var level = top;
     for (var step = 0u; step < max_steps; step++) {
-        let wrapped = wrap_texel(cell, wh);
-        let node = wrapped >> vec2u(level);
-        let first = node << vec2u(level);
-        let lo = cell - wrapped + first;                           // the node's cells, unwrapped
-        let hi = lo + min(vec2i(1 << level), wh - first);
-        let exits = box_exit(start, dir, vec2f(lo), vec2f(hi));
-        let t_exit = min(min(exits.x, exits.y), 1.0);
+        let n = walk_node(cell, level, wh, start, dir);
+        let node = n.index;
+        let lo = n.lo;
+        let hi = n.hi;
+        let exits = n.exits;
+        let t_exit = n.t_exit;
         // May the ray reach this node's relief? Its maximum is in the parent's texel (none for the root;
         // leaves-only walks, top = 1, read the leaves directly).
         var reach = true;
@@ -155,11 +153,7 @@ fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> Trac
         // Nothing in this node: step into the next one along the ray. Look from one level up only when that one
         // is in another parent: this parent was entered because the ray may reach its relief, and still may.
         t = max(t, t_exit);
-        let p = floor(start + t * dir);
-        cell = vec2i(
-            select(clamp(i32(p.x), lo.x, hi.x - 1), select(lo.x - 1, hi.x, dir.x > 0.0), exits.x <= t_exit),
-            select(clamp(i32(p.y), lo.y, hi.y - 1), select(lo.y - 1, hi.y, dir.y > 0.0), exits.y <= t_exit),
-        );
+        cell = next_cell(start, dir, t, exits, lo, hi);
         let same_parent = all((wrap_texel(cell, wh) >> vec2u(up)) == (node >> vec2u(1u)));
         level = select(min(up, top), level, same_parent && level < top);
     }
