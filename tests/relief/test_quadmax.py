@@ -82,18 +82,24 @@ def test_quad_texels_bound_their_childrens_cells(shape):
 MAPS = ("bricks", "bumps", "ridges", "flat0", "flat1", "spike", "step", "wall", "checker")
 
 
+ANGLES = (0, 30, 60, 80, 85, 89, 89.9)
+
+
 @pytest.mark.parametrize("name", MAPS)
 def test_never_behind_the_first_hit_and_accurate(gpu, name):
     h = builtin_height(name, (64, 64))
-    for angle in (0, 30, 60, 80, 85, 89, 89.9):
-        uv, view = random_rays(512, angle, seed=int(angle))
-        got = probe("quadmax", h, uv, view, 0.05)
-        ref = exact_hit(1.0 - h, uv, view, 0.05)
-        ok = ref.valid
-        assert (got.depth[ok] <= ref.t[ok] + T_TOL).all(), (angle, float(np.max(got.depth[ok] - ref.t[ok])))
+    rays = [random_rays(512, angle, seed=int(angle)) for angle in ANGLES]
+    uv, view = np.concatenate([r[0] for r in rays]), np.concatenate([r[1] for r in rays])
+    got = probe("quadmax", h, uv, view, 0.05)
+    ref = exact_hit(1.0 - h, uv, view, 0.05)
+    for i, angle in enumerate(ANGLES):
+        part = slice(512 * i, 512 * (i + 1))
+        ok = ref.valid[part]
+        depth, t = got.depth[part][ok], ref.t[part][ok]
+        assert (depth <= t + T_TOL).all(), (angle, float(np.max(depth - t)))
         if angle <= 89:
-            assert not got.capped[ok].any(), angle
-            err = uv_error_texels(got.uv[ok], ref.uv[ok], (64, 64))
+            assert not got.capped[part][ok].any(), angle
+            err = uv_error_texels(got.uv[part][ok], ref.uv[part][ok], (64, 64))
             assert np.percentile(err, 99) <= 0.02, (angle, float(np.percentile(err, 99)))
 
 
@@ -101,14 +107,13 @@ def test_never_behind_the_first_hit_and_accurate(gpu, name):
                          ids=["npot_343x401", "1x1", "noise_17x9"])
 def test_npot_odd_and_single_texel_maps(gpu, height):
     h = np.asarray(height, np.float64)
-    for angle in (0, 45, 80, 89):
-        uv, view = random_rays(1024, angle, seed=3)
-        got = probe("quadmax", h, uv, view, 0.1)
-        ref = exact_hit(1.0 - h, uv, view, 0.1)
-        assert (got.depth <= ref.t + T_TOL).all(), angle
-        assert not got.capped.any()
-        err = uv_error_texels(got.uv, ref.uv, h.shape[::-1])
-        assert np.percentile(err, 95) <= 0.02, (angle, float(np.percentile(err, 95)))
+    rays = [random_rays(1024, angle, seed=3) for angle in (0, 45, 80, 89)]
+    uv, view = np.concatenate([r[0] for r in rays]), np.concatenate([r[1] for r in rays])
+    got = probe("quadmax", h, uv, view, 0.1)
+    ref = exact_hit(1.0 - h, uv, view, 0.1)
+    assert (got.depth <= ref.t + T_TOL).all() and not got.capped.any()
+    p95 = np.percentile(uv_error_texels(got.uv, ref.uv, h.shape[::-1]).reshape(4, -1), 95, axis=1)
+    assert (p95 <= 0.02).all(), p95
 
 
 def test_cheaper_than_maxmip_and_top_offset_matters(gpu):
