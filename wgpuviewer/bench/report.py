@@ -293,7 +293,7 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
         lines.append("")
         for hl in winners:
             if hl["config"] is not None and hl["config"] != REFERENCE_CONFIG:
-                lines.append(f"- ≤ {hl['budget']:g}: {_label(hl['config'])} takes {_f(hl['simd'] / ref['simd'])}× the "
+                lines.append(f"- ≤ {hl['budget']:g}: {_label(hl['config'])} takes {_f(hl['simd'] / ref['simd'], 3)}× the "
                              f"SIMD-tile fetches ({_f(hl['simd'], 1)} vs {_f(ref['simd'], 1)}) and "
                              f"{_f(hl['ratio'] / ref['ratio'])}× the time of {_label(REFERENCE_CONFIG)} "
                              f"({_f(ref['ratio'])}× basic) over the same measurements.")
