@@ -171,13 +171,17 @@ def test_fetch_percentile_from_counts_is_numpys():
 
 def test_old_results_without_the_new_columns_read_as_missing(tmp_path):
     header = ",".join(c for c in bench.COLUMNS if c not in ("fetches_simd", "simd_tile", "map_bytes"))
-    line = ("full,brick,512x512,pom,layers=8,45,44,46,1920x1080,GPU,Vulkan,timestamp,50,1.5,1,1.5,"
-            "8,9,0.1,0.2,0.3,40,0,1,100")
+    line = ("full,brick,512x512,pom,layers=8,45,44,46,1920x1080,NVIDIA H100 80GB HBM3 (DiscreteGPU) via Vulkan,"
+            "Vulkan,timestamp,50,1.5,1,1.5,8,9,0.1,0.2,0.3,40,0,1,100")
     path = tmp_path / "old.csv"
     path.write_text(header + "\n" + line + "\n")
     (row,) = bench.read_csv(path)
     assert row["ratio_to_basic"] == 1.5 and math.isnan(row["fetches_simd"]) and row["simd_tile"] == ""
     assert list(row) == list(bench.COLUMNS)
+    bench.rereport([path], tmp_path / "again")
+    report = (tmp_path / "again" / "report.md").read_text()
+    assert "| ≤ 1 | pom layers=8 | 1.50 | 8.0 | n/a |" in report  # no SIMD-tile cost measured: n/a, not 0
+    assert "2 of their TPCs" in report  # the H100's graphics: ratios meaningful, milliseconds not
 
 
 # --- the GPU part: batched frames and captures ---------------------------------------------------------

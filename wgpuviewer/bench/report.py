@@ -258,6 +258,10 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
         lines.append("- **software adapter**: times are CPU times of an emulated GPU. Only the ratios to basic "
                      "(measured side by side) and the fetch counts say anything, and the ratios may differ on "
                      "real GPUs.")
+    if "H100" in meta["adapter"] or "H200" in meta["adapter"]:
+        lines.append("- **H100/H200**: graphics runs on 2 of their TPCs (4 of 132 SMs): fragment-shader times use about "
+                     "3 % of the chip. The ratios between techniques are meaningful; the absolute milliseconds are not "
+                     "those of a desktop GPU.")
     if meta["timer"] == "timestamp" and meta["busy_max"] > 1.05:
         lines.append(f"- **warning**: timed GPU intervals add up to {meta['busy_max']:.2f}× the wall time of "
                      "the run: the timestamp unit may not be nanoseconds on this adapter.")
