@@ -177,16 +177,19 @@ def cmd_bench(args) -> int:
             angles = [float(x) for x in names(args.angles, "--angles")]
         except ValueError:
             raise UserError(f"--angles {args.angles!r}: expected comma-separated degrees, e.g. 0,45,80") from None
-    resolution = None
-    if args.resolution:
+    def size(text, option):
+        if not text:
+            return None
         try:
-            resolution = parse_size(args.resolution)
+            return parse_size(text)
         except UserError as e:
-            raise UserError(str(e).replace("--size", "--resolution")) from None
+            raise UserError(str(e).replace("--size", option)) from None
+
     command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["bench"] else "wgpuviewer bench"
-    options = resolve_options(args.suite, resolution=resolution, heightmaps=names(args.heightmaps, "--heightmaps"),
+    options = resolve_options(args.suite, resolution=size(args.resolution, "--resolution"),
+                              heightmaps=names(args.heightmaps, "--heightmaps"),
                               techniques=names(args.techniques, "--techniques"), angles=angles, frames=args.frames,
-                              backend=args.backend, command=command)
+                              backend=args.backend, command=command, simd_tile=size(args.simd_tile, "--simd-tile"))
     out = output_dir(args.out, "--out")  # before a long run, not after it
     if args.from_csv:
         from wgpuviewer.bench.run import rereport
@@ -272,6 +275,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 89)")
     bench.add_argument("--frames", type=int, help="timed frames per configuration (median; default: the suite's)")
     bench.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    bench.add_argument("--simd-tile", help="WIDTHxHEIGHT pixels of the SIMD group for the fetches_simd cost (default 8x4)")
     bench.add_argument("--quiet", action="store_true", help="no progress bar")
     bench.add_argument("--from-csv", nargs="+", metavar="CSV",
                        help="measure nothing: write report.md and plots from these results.csv files into --out")

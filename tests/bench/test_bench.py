@@ -18,8 +18,9 @@ from wgpuviewer.bench.view import (
     load_heightmap,
     make_view,
 )
+from wgpuviewer.relief.accuracy import simd_tile_cost
 from wgpuviewer.relief.reference import sample_bilinear
-from wgpuviewer.relief.renderer import Renderer  # imports wgpu before the log fixture touches its logger
+from wgpuviewer.relief.renderer import DrawConfig, Renderer  # imports wgpu before the log fixture touches its logger
 from wgpuviewer.relief.techniques import TECHNIQUES, Param, Technique
 
 # --- sweeps come from the registry ---------------------------------------------------------------
@@ -131,13 +132,106 @@ def test_pareto_front():
     assert bench_report.pareto_front(pts) == [0, 1, 3]
 
 
+def test_headline_reports_simd_cost_against_the_reference_configuration():
+    rows = []
+    for angle, (d_ratio, d_simd, a_ratio, a_simd) in {0: (2.0, 4.0, 1.0, 0.0), 45: (4.0, 20.0, 2.0, 6.0)}.items():
+        rows += [{**_row("distance", "iterations=256", angle, d_ratio, 0.0), "fetches_simd": d_simd},
+                 {**_row("auto", "max_error=0.5", angle, a_ratio, 0.3), "fetches_simd": a_simd}]
+    best = {h["budget"]: h for h in bench_report.headline(rows)}
+    assert best[0.5]["config"] == ("auto", "max_error=0.5") and best[0.5]["simd"] == 3.0
+    assert best[0.25]["config"] == ("distance", "iterations=256") and best[0.25]["simd"] == 12.0
+    ref = bench_report.reference_cost(rows)
+    assert math.isclose(ref["ratio"], math.sqrt(8.0)) and ref["simd"] == 12.0
+    # a run without the SIMD column (the H100 CSV) has no SIMD cost, not a wrong one
+    old = [{k: v for k, v in r.items() if k != "fetches_simd"} for r in rows]
+    assert math.isnan(bench_report.headline(old)[1]["simd"])
+
+
+def test_cost_correlation_picks_the_better_predictor():
+    rng = np.random.default_rng(1)
+    simd = rng.uniform(1, 50, 40)
+    mean = simd * rng.uniform(0.3, 1.0, 40)  # divergence differs between rows
+    rows = [{"ratio_to_basic": 1 + 0.1 * s, "fetches_mean": m, "fetches_simd": s} for s, m in zip(simd, mean)]
+    c = bench_report.cost_correlation(rows)
+    assert c["rows"] == 40 and math.isclose(c["simd"], 1.0) and c["mean"] < c["simd"]
+    assert bench_report.cost_correlation([{"ratio_to_basic": 1.0, "fetches_mean": 1.0,
+                                           "fetches_simd": float("nan")}])["rows"] == 0
+
+
+def test_fetch_percentile_from_counts_is_numpys():
+    from wgpuviewer.bench.capture import percentile_of_counts
+
+    rng = np.random.default_rng(0)
+    for n in (1, 2, 7, 1000):
+        x = rng.integers(0, 40, n)
+        for q in (0, 5, 50, 95, 100):
+            assert math.isclose(percentile_of_counts(np.bincount(x), q), np.percentile(x, q), abs_tol=1e-9)
+    assert math.isnan(percentile_of_counts(np.zeros(3, np.int64), 95))
+
+
+def test_old_results_without_the_new_columns_read_as_missing(tmp_path):
+    header = ",".join(c for c in bench.COLUMNS if c not in ("fetches_simd", "simd_tile", "map_bytes"))
+    line = ("full,brick,512x512,pom,layers=8,45,44,46,1920x1080,NVIDIA H100 80GB HBM3 (DiscreteGPU) via Vulkan,"
+            "Vulkan,timestamp,50,1.5,1,1.5,8,9,0.1,0.2,0.3,40,0,1,100")
+    path = tmp_path / "old.csv"
+    path.write_text(header + "\n" + line + "\n")
+    (row,) = bench.read_csv(path)
+    assert row["ratio_to_basic"] == 1.5 and math.isnan(row["fetches_simd"]) and row["simd_tile"] == ""
+    assert list(row) == list(bench.COLUMNS)
+    bench.rereport([path], tmp_path / "again")
+    report = (tmp_path / "again" / "report.md").read_text()
+    assert "| ≤ 1 | pom layers=8 | 1.50 | 8.0 | n/a |" in report  # no SIMD-tile cost measured: n/a, not 0
+    assert "2 of their TPCs" in report  # the H100's graphics: ratios meaningful, milliseconds not
+
+
+# --- the GPU part: batched frames and captures ---------------------------------------------------------
+
+def test_batched_capture_is_the_renderers_render_and_a_round_is_one_submit(tmp_path, gpu):
+    """Draws of one technique with different parameters share a submit and keep their own parameters; the bench's
+    fetch statistics come from exactly the data render() gives."""
+    from wgpuviewer.bench.capture import capture
+    from wgpuviewer.bench.timing import time_configs
+
+    view = make_view(load_heightmap("bumps", 64, tmp_path), 60.0, (40, 24))
+    renderer = Renderer(view.scene, gpu)
+    configs = [("basic", {}), ("pom", {"layers": 4}), ("pom", {"layers": 32}), ("parallax", {"offset_limiting": True})]
+    draws = [DrawConfig.of(n, p) for n, p in configs]
+    got = capture(renderer, draws, view.size, max_bytes=2 * 40 * 24 * 20)  # two configurations per batch
+    assert got.submits == 2 and got.readbacks == 4
+    for draw, cap in zip(draws, got.captures):
+        image = renderer.render(draw, view.size)
+        assert (cap.covered == image.covered).all()
+        np.testing.assert_array_equal(cap.data[cap.covered], image.data[image.covered])
+    few, many = (c.data[..., 3][c.covered].mean() for c in got.captures[1:3])
+    assert few < many  # 4 and 32 layers drawn in one submit kept their own layer counts
+    stats = bench._fetch_stats(got.captures[2], (8, 4))
+    fetches = got.captures[2].data[..., 3]
+    image = np.where(fetches < 0, -fetches - 1, fetches)  # negative: capped
+    assert stats["fetches_simd"] == simd_tile_cost(image, (8, 4), got.captures[2].covered)
+    assert math.isclose(stats["fetches_mean"], float(image[got.captures[2].covered].mean()), rel_tol=1e-6)
+    timing = time_configs(renderer, configs, view.size, frames=3, warmup=1)
+    if timing.timer == "timestamp":
+        assert timing.submits == 1 + 1 + 3 and timing.readbacks == 1
+    assert all(r.median_ms > 0 for r in timing.results)
+
+
+def test_map_bytes_counts_the_height_derived_maps(tmp_path, gpu):
+    view = make_view(load_heightmap("bumps", 64, tmp_path), 45.0, (16, 16))
+    renderer = Renderer(view.scene, gpu)
+    sizes = {t: bench.map_bytes(renderer, "relief", t) for t in ("basic", "normal", "pom", "maxmip", "quadmax")}
+    assert sizes["basic"] == sizes["normal"] == 0
+    assert sizes["pom"] == 4 * sum((64 >> k) ** 2 for k in range(7))  # r32float with its mip chain
+    quad_rows = sum((64 + (1 << k) - 1) >> k for k in range(1, 7))  # leaves + quad levels, 32 texels wide
+    assert sizes["quadmax"] == sizes["pom"] + 16 * 32 * quad_rows
+
+
 # --- the smoke suite, end to end ------------------------------------------------------------------
 
 def test_cli_rejects_bad_options(tmp_path, capsys):
     from wgpuviewer.cli import main
 
     for argv in (["--angles", "90"], ["--heightmaps", "nope"], ["--techniques", "nope"],
-                 ["--resolution", "12"], ["--frames", "0"], ["--angles", "a,b"]):
+                 ["--resolution", "12"], ["--frames", "0"], ["--angles", "a,b"], ["--simd-tile", "8"]):
         assert main(["bench", "--suite", "smoke", "--out", str(tmp_path), *argv]) == 2
         err = capsys.readouterr().err
         assert err.startswith("wgpuviewer: error: --") and "Traceback" not in err
@@ -158,20 +252,24 @@ def test_smoke_suite_writes_complete_sane_outputs(tmp_path, gpu):
         assert r["gpu_ms"] > 0 and r["basic_ms"] > 0 and r["adapter"] and r["frames"] == suite.frames
         assert r["angle_min"] - 0.1 <= r["angle"] <= r["angle_max"] + 0.1
         assert 0 <= r["capped_fraction"] <= 1 and 0 < r["covered_fraction"] <= 1
-        assert r["fetches_p95"] >= 0 and r["fetches_mean"] >= 0
+        assert r["fetches_p95"] >= 0 and r["fetches_mean"] >= 0 and r["fetches_simd"] >= 0
+        assert r["simd_tile"] == "8x4" and r["map_bytes"] >= 0
         if r["eval_pixels"] > 0:
             assert 0 <= r["uv_err_mean"] <= r["uv_err_max"] and 0 <= r["uv_err_p95"] <= r["uv_err_max"]
             assert 0 < r["psnr_db"] <= 99
         if r["technique"] == "basic":
-            assert r["ratio_to_basic"] == 1 and r["fetches_mean"] == 0
+            assert r["ratio_to_basic"] == 1 and r["fetches_mean"] == 0 and r["fetches_simd"] == 0
+            assert r["map_bytes"] == 0
     # the error metric sees parallax: no displacement is far off at 60°, many POM layers are close
     by = {(r["heightmap"], r["technique"], r["params"], r["angle"]): r for r in rows}
     assert by["bricks", "basic", "-", 60.0]["uv_err_p95"] > 2.0
     assert by["bricks", "pom", "layers=64", 60.0]["uv_err_p95"] < 0.25
     assert by["bricks", "pom", "layers=64", 60.0]["psnr_db"] > by["bricks", "basic", "-", 60.0]["psnr_db"]
     report = (out / "report.md").read_text()
-    for section in ("## Headline", "## The thesis' experiment (Table 4.1)", "## Per height map", "## Plots"):
+    for section in ("## Headline", "## The thesis' experiment (Table 4.1)", "## Per height map",
+                    "## Map memory per technique", "## Which cost predicts the time", "## The run", "## Plots"):
         assert section in report
+    assert "SIMD-tile fetches" in report and "the SIMD-tile fetches" in report  # the comparison with distance
     assert rows[0]["adapter"] in report
     if "pom_adaptive" in TECHNIQUES:
         assert "Speed-up of adaptive POM" in report
@@ -182,6 +280,6 @@ def test_smoke_suite_writes_complete_sane_outputs(tmp_path, gpu):
     except ImportError:
         assert "matplotlib is not installed" in report
     else:
-        for name in ("pareto.png", "fetches_vs_angle.png"):
+        for name in ("pareto.png", "fetches_vs_angle.png", "cost_vs_time.png"):
             data = (out / name).read_bytes()
             assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) < 400_000

@@ -62,7 +62,10 @@ def test_fetches_within_the_declared_bound(gpu, technique):
         uv, view = random_rays(512, angle, seed=7)
         for name in ("bricks", "checker", "spike"):
             got = probe(technique, height_map(name), uv, view, 0.05)
-            assert got.fetches.min() >= 1 and got.fetches.max() <= bound, (name, angle, int(got.fetches.max()))
+            assert got.fetches.max() <= bound, (name, angle, int(got.fetches.max()))
+            # fetches are counted: a ray that fetched nothing did not move (auto's basic candidate)
+            idle = got.fetches == 0
+            assert np.allclose(got.uv[idle], uv[idle], atol=1e-6), (name, angle)
 
 
 @pytest.mark.parametrize("technique", EXACT)

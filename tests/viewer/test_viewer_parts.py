@@ -185,3 +185,18 @@ def test_gpu_timer_reads_back_pass_times_without_blocking(gpu, scene):
             break
         time.sleep(0.01)
     assert len(times) >= 3 and all(0 < t < 10_000 for t in times), times
+
+
+def test_hud_lines_say_what_auto_chooses(gpu):
+    from wgpuviewer.relief.techniques import AUTO_CANDIDATES
+    from wgpuviewer.viewer.hud import auto_lines
+
+    scene = load_scene(os.path.join(os.path.dirname(__file__), "..", "relief", "golden", "scene.toml"))
+    renderer = Renderer(scene, gpu)
+    lines = auto_lines(renderer, 0.7)
+    assert lines[0] == "auto at max_error 0.7: budget 0.5 texel"
+    assert set(scene.materials) <= {line.rstrip(":") for line in lines}
+    names = {name for name, _ in AUTO_CANDIDATES}
+    ranges = [line for line in lines if "°:" in line]
+    assert ranges and all(line.split(": ")[1].split()[0].rstrip(",") in names for line in ranges)
+    assert ranges[0].strip().startswith("0.0-") and lines[-1].split(":")[0].endswith("90°")

@@ -11,6 +11,8 @@ import numpy as np
 
 BUDGETS = (0.25, 0.5, 1.0)  # texels, p95 UV error
 HEADLINE_MAX_ANGLE = 80.0  # the headline asks for the budget at every angle up to this
+#: The configuration the headline's winner is compared with (the winner of the first H100 run).
+REFERENCE_CONFIG = ("distance", "iterations=256")
 
 #: Thesis Table 4.1 (papers.md, 002): FPS per angle for POM 4/8/16/24/32 layers and adaptive 4-32.
 THESIS_ANGLES = (0.0, 45.0, 60.0, 80.0)
@@ -66,13 +68,42 @@ def headline(values: list[dict], max_angle: float = HEADLINE_MAX_ANGLE) -> list[
         for key, vs in by_config.items():
             if all(v["uv_err_p95"] <= budget for v in vs):  # NaN (no pixel evaluated) fails
                 ratio = _geomean(v["ratio_to_basic"] for v in vs)
-                fetches = float(np.mean([v["fetches_mean"] for v in vs]))
-                worst = max(v["uv_err_p95"] for v in vs)
                 if best is None or ratio < best["ratio"]:
-                    best = {"budget": budget, "config": key, "ratio": ratio, "fetches": fetches, "worst_p95": worst,
-                            "cases": len(vs)}
+                    best = {"budget": budget, "config": key, "ratio": ratio, "cases": len(vs), **cost_of(vs)}
         out.append(best or {"budget": budget, "config": None})
     return out
+
+
+def cost_of(vs: list[dict]) -> dict:
+    """Mean fetches, mean SIMD-tile fetches (NaN for runs without the column), worst p95 of some measurements."""
+    simd = [v.get("fetches_simd", float("nan")) for v in vs]
+    return {"fetches": float(np.mean([v["fetches_mean"] for v in vs])),
+            "simd": float(np.mean(simd)) if all(math.isfinite(x) for x in simd) else float("nan"),
+            "worst_p95": max(v["uv_err_p95"] for v in vs)}
+
+
+def reference_cost(values: list[dict], max_angle: float = HEADLINE_MAX_ANGLE) -> dict | None:
+    """REFERENCE_CONFIG's geometric-mean time ratio and costs over the headline's measurements (None if not run)."""
+    vs = [v for v in values if _key(v) == REFERENCE_CONFIG and v["angle"] <= max_angle]
+    if not vs:
+        return None
+    return {"ratio": _geomean(v["ratio_to_basic"] for v in vs), **cost_of(vs)}
+
+
+def pearson(x, y) -> float:
+    x, y = np.asarray(x, np.float64), np.asarray(y, np.float64)
+    if len(x) < 3 or x.std() == 0 or y.std() == 0:
+        return float("nan")
+    return float(np.corrcoef(x, y)[0, 1])
+
+
+def cost_correlation(values: list[dict]) -> dict:
+    """Pearson correlation over all rows of the time ratio to basic with mean fetches and with SIMD-tile fetches."""
+    rows = [v for v in values if all(math.isfinite(v.get(k, float("nan")))
+                                     for k in ("ratio_to_basic", "fetches_mean", "fetches_simd"))]
+    ratio = [v["ratio_to_basic"] for v in rows]
+    return {"rows": len(rows), "mean": pearson([v["fetches_mean"] for v in rows], ratio),
+            "simd": pearson([v["fetches_simd"] for v in rows], ratio)}
 
 
 def per_angle_budget(values: list[dict]) -> dict:
@@ -227,6 +258,10 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
         lines.append("- **software adapter**: times are CPU times of an emulated GPU. Only the ratios to basic "
                      "(measured side by side) and the fetch counts say anything, and the ratios may differ on "
                      "real GPUs.")
+    if "H100" in meta["adapter"] or "H200" in meta["adapter"]:
+        lines.append("- **H100/H200**: graphics runs on 2 of their TPCs (4 of 132 SMs): fragment-shader times use about "
+                     "3 % of the chip. The ratios between techniques are meaningful; the absolute milliseconds are not "
+                     "those of a desktop GPU.")
     if meta["timer"] == "timestamp" and meta["busy_max"] > 1.05:
         lines.append(f"- **warning**: timed GPU intervals add up to {meta['busy_max']:.2f}× the wall time of "
                      "the run: the timestamp unit may not be nanoseconds on this adapter.")
@@ -240,13 +275,32 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
               f"A configuration meets a budget when its p95 UV error is within it in every measurement up to "
               f"{HEADLINE_MAX_ANGLE:g}° (all height maps of this run); cost is the geometric mean of its time "
               "ratio to basic over those measurements.", "",
-              "| p95 budget (texels) | cheapest | × basic | fetches/pixel (mean) | worst p95 |", "|---|---|---|---|---|"]
-    for hl in headline(values):
+              "| p95 budget (texels) | cheapest | × basic | fetches/pixel (mean) | SIMD-tile fetches (mean) | worst p95 |",
+              "|---|---|---|---|---|---|"]
+    winners = headline(values)
+    for hl in winners:
         if hl["config"] is None:
-            lines.append(f"| ≤ {hl['budget']:g} | none of the measured configurations | – | – | – |")
+            lines.append(f"| ≤ {hl['budget']:g} | none of the measured configurations | – | – | – | – |")
         else:
             lines.append(f"| ≤ {hl['budget']:g} | {_label(hl['config'])} | {_f(hl['ratio'])} | "
-                         f"{_f(hl['fetches'], 1)} | {_f(hl['worst_p95'])} |")
+                         f"{_f(hl['fetches'], 1)} | {_f(hl['simd'], 1)} | {_f(hl['worst_p95'])} |")
+    if meta["software"]:
+        lines += ["", "**Software adapter: these time ratios are llvmpipe's (CPU time of an emulated GPU). The GPU "
+                  "headline is still to be measured** (the full suite on a GPU, docs/benchmarks.md); the fetch counts "
+                  "are the machine-independent part."]
+    tw, th = suite.simd_tile
+    lines += ["", f"SIMD-tile fetches: the mean over screen tiles of {tw}x{th} pixels of the tile's largest fetch "
+              "count (what a SIMD group of that many lanes pays when its lanes loop until the slowest is done), "
+              "averaged over the measurements."]
+    ref = reference_cost(values)
+    if ref is not None:
+        lines.append("")
+        for hl in winners:
+            if hl["config"] is not None and hl["config"] != REFERENCE_CONFIG:
+                lines.append(f"- ≤ {hl['budget']:g}: {_label(hl['config'])} takes {_f(hl['simd'] / ref['simd'], 3)}× the "
+                             f"SIMD-tile fetches ({_f(hl['simd'], 1)} vs {_f(ref['simd'], 1)}) and "
+                             f"{_f(hl['ratio'] / ref['ratio'])}× the time of {_label(REFERENCE_CONFIG)} "
+                             f"({_f(ref['ratio'])}× basic) over the same measurements.")
     angles = sorted({v["angle"] for v in values})
     pab = per_angle_budget(values)
     lines += ["", "Per angle (p95 within the budget on every height map at that angle):", "",
@@ -262,14 +316,15 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
     lines += table41_section(values, "pom_adaptive" in TECHNIQUES)
 
     lines += ["## Per height map", "",
-              "Time ratio to basic and fetches: mean over the angles; then the p95 UV error (texels) per angle. "
+              "Time ratio to basic, fetches and SIMD-tile fetches: mean over the angles; then the p95 UV error (texels) "
+              "per angle. "
               "All numbers per measurement are in results.csv.", ""]
     for m in dict.fromkeys(v["heightmap"] for v in values):
         vs = [v for v in values if v["heightmap"] == m]
         m_angles = sorted({v["angle"] for v in vs})
         lines += [f"### {m} ({vs[0]['heightmap_size']})", "",
-                  "| configuration | × basic | fetches | capped | min PSNR (dB) | " +
-                  " | ".join(f"p95 {a:g}°" for a in m_angles) + " |", "|---" * (len(m_angles) + 5) + "|"]
+                  "| configuration | × basic | fetches | SIMD-tile fetches | capped | min PSNR (dB) | " +
+                  " | ".join(f"p95 {a:g}°" for a in m_angles) + " |", "|---" * (len(m_angles) + 6) + "|"]
         by_config = defaultdict(dict)
         for v in vs:
             by_config[_key(v)][v["angle"]] = v
@@ -278,11 +333,13 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
             lines.append(
                 f"| {_label(key)} | {_f(float(np.mean([r['ratio_to_basic'] for r in rows])))} | "
                 f"{_f(float(np.mean([r['fetches_mean'] for r in rows])), 1)} | "
+                f"{_f(float(np.mean([r['fetches_simd'] for r in rows])), 1)} | "
                 f"{float(np.mean([r['capped_fraction'] for r in rows])):.1%} | "
                 f"{_f(float(np.nanmin([r['psnr_db'] for r in rows])), 1)} | "
                 + " | ".join(_f(per_angle[a]["uv_err_p95"]) if a in per_angle else "–" for a in m_angles) + " |")
         lines.append("")
 
+    lines += memory_section(values) + correlation_section(values, meta) + run_section(meta)
     lines += ["## Plots", ""]
     if plot_note:
         lines.append(plot_note)
@@ -290,6 +347,80 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
         lines.append(f"![{p}]({p})")
     lines.append("")
     return "\n".join(lines)
+
+
+# --- map memory, cost model, the run ---------------------------------------------------------------
+
+def _bytes(n: float) -> str:
+    if not math.isfinite(n):
+        return "n/a"
+    for unit, size in (("MiB", 1 << 20), ("KiB", 1 << 10)):
+        if n >= size:
+            return f"{n / size:.1f} {unit}"
+    return f"{n:.0f} B"
+
+
+def memory_section(values: list[dict]) -> list[str]:
+    """GPU memory of the height-derived maps each technique samples, per height map size."""
+    sizes = list(dict.fromkeys(v["heightmap_size"] for v in values))
+    table = defaultdict(dict)
+    for v in values:
+        table[v["technique"]][v["heightmap_size"]] = v.get("map_bytes", float("nan"))
+    if all(not math.isfinite(b) for t in table.values() for b in t.values()):
+        return []
+    lines = ["## Map memory per technique", "",
+             "GPU memory of the height-derived maps a technique samples (the depth map with its mip chain and the maps "
+             "built from it; the material's albedo and normal map are not counted), per height map size:", "",
+             "| technique | " + " | ".join(sizes) + " |", "|---" * (len(sizes) + 1) + "|"]
+    for technique, per_size in table.items():
+        lines.append(f"| {technique} | " + " | ".join(_bytes(per_size.get(s, float("nan"))) for s in sizes) + " |")
+    return lines + [""]
+
+
+def correlation_section(values: list[dict], meta: dict) -> list[str]:
+    c = cost_correlation(values)
+    if c["rows"] < 3 or not (math.isfinite(c["mean"]) and math.isfinite(c["simd"])):
+        return []
+    better = "SIMD-tile fetches" if c["simd"] > c["mean"] else "mean fetches"
+    lines = ["## Which cost predicts the time", "",
+             f"Pearson correlation over all {c['rows']} rows of the time ratio to basic with the mean fetches per "
+             f"pixel: r = {c['mean']:.3f}; with the SIMD-tile fetches: r = {c['simd']:.3f}. **{better}** predict "
+             "the time better on this adapter."]
+    if meta.get("software"):
+        lines.append("On a software adapter the times are CPU times of an emulated GPU: this says which cost predicts "
+                     "llvmpipe, not a GPU. Run the full suite on a GPU for that.")
+    per = per_fetch_time(values)
+    if per:
+        pom = per.get("pom")
+        lines += ["", "Time per SIMD-tile fetch (median over the rows with at least one fetch of (time / basic - 1) / "
+                  "SIMD-tile fetches)" + (", also in POM fetches (auto's COST_WEIGHTS come from this)" if pom else "")
+                  + ":", "", "| technique | × basic per fetch |" + (" in POM fetches |" if pom else ""),
+                  "|---|---|" + ("---|" if pom else "")]
+        for technique, value in per.items():
+            lines.append(f"| {technique} | {value:.3f} |" + (f" {value / pom:.2f} |" if pom else ""))
+    return lines + [""]
+
+
+def per_fetch_time(values: list[dict]) -> dict:
+    """technique -> median over its rows with fetches of (ratio_to_basic - 1) / fetches_simd."""
+    out = defaultdict(list)
+    for v in values:
+        simd = v.get("fetches_simd", float("nan"))
+        if math.isfinite(simd) and simd >= 1 and math.isfinite(v["ratio_to_basic"]):
+            out[v["technique"]].append((v["ratio_to_basic"] - 1.0) / simd)
+    return {t: float(np.median(xs)) for t, xs in out.items()}
+
+
+def run_section(meta: dict) -> list[str]:
+    phases, counters = meta.get("phases"), meta.get("counters")
+    if not phases or not counters:
+        return []
+    views = max(counters["views"], 1)
+    return ["## The run", "",
+            "Wall time per phase: " + ", ".join(f"{name} {seconds:.1f} s" for name, seconds in phases.items())
+            + f". GPU work per view (all {len(meta['configs'])} configurations): "
+            f"{counters['submits'] / views:.1f} submits and {counters['readbacks'] / views:.1f} read-backs "
+            f"({counters['submits']} and {counters['readbacks']} in all, {counters['views']} views).", ""]
 
 
 # --- plots ------------------------------------------------------------------------------------
@@ -368,6 +499,26 @@ def plots(out: Path, values: list[dict]) -> tuple[list[str], str | None]:
     _save(fig, out / "fetches_vs_angle.png")
     plt.close(fig)
     written.append("fetches_vs_angle.png")
+
+    c = cost_correlation(values)
+    if c["rows"] >= 3:
+        rows = [v for v in values if math.isfinite(v.get("fetches_simd", float("nan")))]
+        fig, axes = plt.subplots(1, 2, figsize=(9, 4), sharey=True)
+        for ax, column, title, r in ((axes[0], "fetches_mean", "mean fetches per pixel", c["mean"]),
+                                      (axes[1], "fetches_simd", "SIMD-tile fetches", c["simd"])):
+            for t in techniques:
+                vs = [v for v in rows if v["technique"] == t]
+                ax.scatter([v[column] for v in vs], [v["ratio_to_basic"] for v in vs], s=8, color=colors[t], label=t)
+            ax.set_xscale("symlog", linthresh=1)
+            ax.set_yscale("log")
+            ax.set_xlabel(title)
+            ax.set_title(f"Pearson r = {r:.3f} (all rows)", fontsize=9)
+        axes[0].set_ylabel("time / basic")
+        axes[1].legend(fontsize=6, ncol=2)
+        fig.tight_layout()
+        _save(fig, out / "cost_vs_time.png")
+        plt.close(fig)
+        written.append("cost_vs_time.png")
     return written, None
 
 

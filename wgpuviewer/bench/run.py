@@ -23,6 +23,7 @@ import datetime
 import platform
 import sys
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -39,6 +40,7 @@ SWEEPS: dict[str, tuple[dict, ...]] = {
     "steep": ({"layers": 8}, {"layers": 16}, {"layers": 32}, {"layers": 64}),
     "pom": tuple({"layers": n} for n in (4, 8, 16, 24, 32, 64, 128)),
     "pom_adaptive": ({},),
+    "auto": ({"max_error": 0.25}, {"max_error": 0.5}, {"max_error": 1.0}),
 }
 
 #: The smoke suite's smaller sweeps (still all of Table 4.1's POM layer counts).
@@ -47,6 +49,7 @@ SMOKE_SWEEPS: dict[str, tuple[dict, ...]] = {
     "steep": ({"layers": 16},),
     "pom": tuple({"layers": n} for n in (4, 8, 16, 24, 32, 64)),
     "pom_adaptive": ({},),
+    "auto": ({"max_error": 0.25}, {"max_error": 0.5}),
 }
 
 BASELINE = "basic"
@@ -66,13 +69,16 @@ class Suite:
     sweeps: dict = field(default_factory=dict)
     eval_pixels: int = 65536  # pixels per measurement compared with the reference
     builtin_size: int = 256
+    simd_tile: tuple[int, int] = (8, 4)  # (width, height) pixels of the SIMD group in fetches_simd
+    reference_workers: int = 0  # processes for the float64 reference hits (0: in this process)
 
 
 SUITES = {
     "smoke": Suite("smoke", ("brick", "bricks", "spike"), (0.0, 45.0, 60.0, 80.0, 89.0), (96, 54), 30, 3,
                    SMOKE_SWEEPS, eval_pixels=1500, builtin_size=128),
-    "full": Suite("full", REAL_MAPS + SYNTHETIC_MAPS, ALL_ANGLES, (1920, 1080), 50, 5, SWEEPS,
-                  eval_pixels=32768, builtin_size=256),
+    # 20 frames after 2 warm-up rounds: the whole suite in one 8-minute run on an H100-class GPU (docs/benchmarks.md)
+    "full": Suite("full", REAL_MAPS + SYNTHETIC_MAPS, ALL_ANGLES, (1920, 1080), 20, 2, SWEEPS,
+                  eval_pixels=32768, builtin_size=256, reference_workers=-1),
 }
 
 COLUMNS = (
@@ -80,6 +86,9 @@ COLUMNS = (
     "resolution", "adapter", "backend", "timer", "frames", "gpu_ms", "basic_ms", "ratio_to_basic",
     "fetches_mean", "fetches_p95", "uv_err_mean", "uv_err_p95", "uv_err_max", "psnr_db",
     "capped_fraction", "covered_fraction", "eval_pixels",
+    # added by issue 13: the divergence-aware cost (mean over screen tiles of the tile's largest fetch count), the
+    # tile it was computed for, and the memory of the height-derived maps the technique samples
+    "fetches_simd", "simd_tile", "map_bytes",
 )
 
 
@@ -130,7 +139,7 @@ class Options:
 
 
 def resolve_options(suite_name: str, resolution=None, heightmaps=None, techniques=None, angles=None,
-                    frames=None, backend=None, command="") -> Options:
+                    frames=None, backend=None, command="", simd_tile=None) -> Options:
     """Validated run options (UserError naming the option on bad input)."""
     from wgpuviewer.textures import BUILTINS
 
@@ -140,6 +149,8 @@ def resolve_options(suite_name: str, resolution=None, heightmaps=None, technique
     notes = []
     if resolution is not None:
         suite = replace(suite, resolution=tuple(resolution))
+    if simd_tile is not None:
+        suite = replace(suite, simd_tile=tuple(simd_tile))
     if frames is not None:
         if frames < 1:
             raise UserError(f"--frames {frames}: expected at least 1 (30 or more for a stable median)")
@@ -183,31 +194,123 @@ class Row:
     errors: np.ndarray  # per-pixel UV errors (texels), kept for pooled statistics
 
 
+#: Bytes per texel of the formats the height-derived maps use (map memory per technique).
+FORMAT_BYTES = {"r8unorm": 1, "r16float": 2, "r32float": 4, "rgba8unorm": 4, "rgba16float": 8, "rgba32float": 16,
+                "rgba32uint": 16}
+
+
+def texture_bytes(texture) -> int:
+    """GPU memory of a texture's texels, all mip levels (3D textures halve their depth too)."""
+    w, h, d = texture.size
+    total = 0
+    for level in range(texture.mip_level_count):
+        depth = max(d >> level, 1) if texture.dimension == "3d" else d
+        total += max(w >> level, 1) * max(h >> level, 1) * depth
+    return total * FORMAT_BYTES[texture.format]
+
+
+def map_bytes(renderer, material: str, technique: str) -> int:
+    """Memory of the height-derived maps (depth and what is built from it) ``technique`` samples on ``material``."""
+    from wgpuviewer.relief.maps import MAP_SLOTS
+
+    return sum(texture_bytes(renderer.texture(material, slot)) for slot in TECHNIQUES[technique].textures
+               if MAP_SLOTS[slot].derived)
+
+
+def _fetch_stats(capture, tile) -> dict:
+    """Fetch statistics of one capture over the covered pixels: mean, p95 (from integer counts), SIMD-tile cost."""
+    from wgpuviewer.relief.accuracy import simd_tile_cost
+
+    from .capture import percentile_of_counts
+
+    raw = capture.data[:, :, 3]
+    covered = capture.covered
+    capped = raw < 0
+    image = np.where(capped, -raw - 1.0, raw) if capped.any() else raw  # fetch counts: whole numbers
+    counted = image if covered.all() else image[covered]
+    counts = np.bincount(counted.astype(np.int32).ravel()) if counted.size else np.zeros(1, np.int64)
+    n = int(counts.sum())
+    mean = float(counts @ np.arange(len(counts)) / n) if n else float("nan")
+    n_capped = int(np.count_nonzero(capped & covered))
+    return {"fetches_mean": mean, "fetches_p95": percentile_of_counts(counts, 95),
+            "fetches_simd": simd_tile_cost(image, tile, covered),
+            "capped_fraction": n_capped / n if n else float("nan"),
+            "covered_fraction": float(covered.mean())}
+
+
+def _view_rows(suite, heightmap, view, configs, timing, captures, sizes, pending_reference, adapter_backend):
+    """The CSV rows of one view from its timing and captures (errors against the view's reference)."""
+    from .view import Shader, errors
+
+    adapter, backend = adapter_backend
+    ref = pending_reference.result()
+    shader = Shader(view)
+    size = view.size
+    basic_ms = timing.results[0].median_ms
+    rows = []
+    for (name, params), t, cap in zip(configs, timing.results, captures):
+        err = errors(view, ref, cap.data, cap.covered, shader)
+        e = err.uv_texels
+        rows.append(Row({
+            "suite": suite.name, "heightmap": heightmap.name,
+            "heightmap_size": f"{heightmap.size[0]}x{heightmap.size[1]}",
+            "technique": name, "params": params_label(params), "angle": view.angle,
+            "angle_min": round(view.angle_min, 3), "angle_max": round(view.angle_max, 3),
+            "resolution": f"{size[0]}x{size[1]}", "adapter": adapter, "backend": backend,
+            "timer": timing.timer, "frames": suite.frames,
+            "gpu_ms": t.median_ms, "basic_ms": basic_ms,
+            "ratio_to_basic": t.median_ms / basic_ms if basic_ms > 0 else float("nan"),
+            "uv_err_mean": float(e.mean()) if e.size else float("nan"),
+            "uv_err_p95": float(np.percentile(e, 95)) if e.size else float("nan"),
+            "uv_err_max": float(e.max()) if e.size else float("nan"),
+            "psnr_db": err.psnr, "eval_pixels": err.pixels,
+            **_fetch_stats(cap, suite.simd_tile),
+            "simd_tile": f"{suite.simd_tile[0]}x{suite.simd_tile[1]}", "map_bytes": sizes[name],
+        }, e))
+    return rows
+
+
 def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
-    """Run the benchmark; write ``out``/results.csv, report.md and plots. Returns the CSV rows."""
+    """Run the benchmark; write ``out``/results.csv, report.md and plots. Returns the CSV rows.
+
+    Phases: (1) every height map's views, and every map each configuration samples built up front (from the disk
+    cache when it holds them; auto's tables measured), so the timed part only draws; (2) the float64 reference
+    hits of every view, in a process pool when the suite asks for one (full: on all but one CPU core), while
+    (3) the GPU part runs view by view: timing (one submit per round of frames), then every configuration's trace
+    data in batches (one submit and two read-backs per batch); a worker thread turns each view's data into rows
+    (fetch statistics, errors against the reference) while the GPU works on the next view."""
+    import time
+
     from tqdm import tqdm
 
     from wgpuviewer.core.gpu import get_gpu
     from wgpuviewer.relief.renderer import DrawConfig, Renderer
 
+    from .capture import capture
     from .report import write_outputs
     from .timing import time_configs
-    from .view import Shader, errors, load_heightmap, make_view, reference
+    from .view import load_heightmap, make_view, reference_pool
 
     suite = options.suite
     gpu = get_gpu(options.backend, quiet=True)
     adapter = gpu.summary
     backend = gpu.adapter.info.get("backend_type", "")
     configs = configs_for(options.techniques, suite.sweeps)
+    draws = [DrawConfig.of(name, params) for name, params in configs]
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     size = suite.resolution
     rows: list[Row] = []
     busy = []
+    counters = {"submits": 0, "readbacks": 0}
+    phases = {}
     started = datetime.datetime.now(datetime.UTC)
     total = len(suite.heightmaps) * len(suite.angles) * len(configs)
     with tempfile.TemporaryDirectory(prefix="wgpuviewer-bench-") as workdir, \
             tqdm(total=total, desc="bench", unit="row", file=sys.stderr, disable=not progress) as bar:
+        # (1) height maps, views and every map the configurations sample
+        clock = time.perf_counter()
+        work = []  # (heightmap, views, the renderer whose maps and pipelines its views share, map bytes per technique)
         for map_name in suite.heightmaps:
             try:
                 heightmap = load_heightmap(map_name, suite.builtin_size, Path(workdir))
@@ -215,47 +318,51 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
                 options.notes.append(f"height map {map_name!r} left out: {type(e).__name__}: {e}")
                 bar.update(len(suite.angles) * len(configs))
                 continue
+            views = []
             for angle in suite.angles:
-                bar.set_postfix_str(f"{map_name} {angle:g}°")
                 try:
-                    view = make_view(heightmap, angle, size)
+                    views.append(make_view(heightmap, angle, size))
                 except ValueError as e:
                     raise UserError(f"--angles {angle:g}: {e}") from None
-                renderer = Renderer(view.scene, gpu)
-                timing = time_configs(renderer, configs, size, suite.frames, suite.warmup)
-                busy.append(timing.busy_fraction)
-                ref = reference(view, suite.eval_pixels)
-                shader = Shader(view)
-                basic_ms = timing.results[0].median_ms
-                for (name, params), t in zip(configs, timing.results):
-                    image = renderer.render(DrawConfig.of(name, params), size)
-                    covered = image.covered
-                    raw = image.data[:, :, 3][covered]
-                    capped = raw < 0
-                    fetches = np.where(capped, -raw - 1.0, raw).astype(np.float64)
-                    err = errors(view, ref, image.data, covered, shader)
-                    e = err.uv_texels
-                    rows.append(Row({
-                        "suite": suite.name, "heightmap": map_name,
-                        "heightmap_size": f"{heightmap.size[0]}x{heightmap.size[1]}",
-                        "technique": name, "params": params_label(params), "angle": angle,
-                        "angle_min": round(view.angle_min, 3), "angle_max": round(view.angle_max, 3),
-                        "resolution": f"{size[0]}x{size[1]}", "adapter": adapter, "backend": backend,
-                        "timer": timing.timer, "frames": suite.frames,
-                        "gpu_ms": t.median_ms, "basic_ms": basic_ms,
-                        "ratio_to_basic": t.median_ms / basic_ms if basic_ms > 0 else float("nan"),
-                        "fetches_mean": float(fetches.mean()) if fetches.size else float("nan"),
-                        "fetches_p95": float(np.percentile(fetches, 95)) if fetches.size else float("nan"),
-                        "uv_err_mean": float(e.mean()) if e.size else float("nan"),
-                        "uv_err_p95": float(np.percentile(e, 95)) if e.size else float("nan"),
-                        "uv_err_max": float(e.max()) if e.size else float("nan"),
-                        "psnr_db": err.psnr,
-                        "capped_fraction": float(capped.mean()) if capped.size else float("nan"),
-                        "covered_fraction": float(covered.mean()),
-                        "eval_pixels": err.pixels,
-                    }, e))
-                    bar.update()
+            bar.set_postfix_str(f"{map_name}: maps")
+            first = Renderer(views[0].scene, gpu)  # the views of this map share its maps and pipelines
+            sizes = {name: map_bytes(first, "relief", name) for name in dict.fromkeys(n for n, _ in configs)}
+            work.append((heightmap, views, first, sizes))
+        phases["maps"] = time.perf_counter() - clock
+        # (2) reference hits, all views at once (a pool works on them while the GPU part runs)
+        clock = time.perf_counter()
+        pending = reference_pool([v for _, views, _, _ in work for v in views], suite.eval_pixels,
+                                 suite.reference_workers)
+        gpu_s = 0.0
+        processing: list = []  # one future per view: its rows, built while the GPU works on the next views
+
+        def collect(block: bool):
+            while processing and (block or processing[0].done()):
+                new_rows = processing.pop(0).result()
+                rows.extend(new_rows)
+                bar.update(len(new_rows))
                 write_csv(out / "results.csv", [r.values for r in rows])  # partial results survive a kill
+
+        with ThreadPoolExecutor(max_workers=1) as worker:
+            for index, (heightmap, views, first, sizes) in enumerate(work):
+                for view in views:
+                    bar.set_postfix_str(f"{heightmap.name} {view.angle:g}°")
+                    # (3) the GPU part of this view
+                    gpu_clock = time.perf_counter()
+                    renderer = Renderer(view.scene, gpu, like=first)
+                    timing = time_configs(renderer, configs, size, suite.frames, suite.warmup)
+                    data = capture(renderer, draws, size)
+                    gpu_s += time.perf_counter() - gpu_clock
+                    counters["submits"] += timing.submits + data.submits
+                    counters["readbacks"] += timing.readbacks + data.readbacks
+                    busy.append(timing.busy_fraction)
+                    collect(block=len(processing) >= 2)  # at most two views' data waiting
+                    processing.append(worker.submit(_view_rows, suite, heightmap, view, configs, timing,
+                                                    data.captures, sizes, pending.pop(0), (adapter, backend)))
+                work[index] = (heightmap, views, None, sizes)  # this height map is done: free its maps and pipelines
+            collect(block=True)
+        phases["gpu"] = gpu_s
+        phases["references and errors, not overlapped with the GPU part"] = time.perf_counter() - clock - gpu_s
     finished = datetime.datetime.now(datetime.UTC)
     meta = {
         "suite": suite, "adapter": adapter, "backend": backend, "software": gpu.software,
@@ -264,6 +371,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
         "notes": options.notes, "configs": configs,
         "techniques": options.techniques, "busy_max": max(busy) if busy else float("nan"),
         "python": platform.python_version(), "platform": platform.platform(),
+        "phases": phases, "counters": {**counters, "views": sum(len(w[1]) for w in work)},
     }
     write_csv(out / "results.csv", [r.values for r in rows])
     write_outputs(out, rows, meta)
@@ -274,12 +382,21 @@ def write_csv(path: Path, rows: list[dict]) -> None:
     core_io.write_csv(path, COLUMNS, rows)
 
 
+#: Text columns of results.csv (the others are numbers).
+TEXT_COLUMNS = {"suite", "heightmap", "heightmap_size", "technique", "params", "resolution", "adapter", "backend",
+                "timer", "simd_tile"}
+
+
 def read_csv(path: Path) -> list[dict]:
-    """results.csv back as dicts with numbers parsed (for tests and re-reporting)."""
-    numeric = set(COLUMNS) - {"suite", "heightmap", "heightmap_size", "technique", "params", "resolution",
-                              "adapter", "backend", "timer"}
+    """results.csv back as dicts with numbers parsed (for tests and re-reporting). Columns added after a file was
+    written (e.g. fetches_simd in the H100 run) read as NaN (numbers) or "" (text)."""
     with open(path, newline="", encoding="utf-8") as f:
-        return [{k: (float(v) if k in numeric else v) for k, v in row.items()} for row in csv.DictReader(f)]
+        rows = list(csv.DictReader(f))
+    out = []
+    for row in rows:
+        values = {k: (v if k in TEXT_COLUMNS else float(v) if v != "" else float("nan")) for k, v in row.items()}
+        out.append({**{k: "" if k in TEXT_COLUMNS else float("nan") for k in COLUMNS}, **values})
+    return out
 
 
 def rereport(csv_paths: list[Path], out: Path, command: str = "") -> list[dict]:

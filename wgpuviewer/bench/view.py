@@ -19,6 +19,9 @@ The set-up (also in docs/benchmarks.md):
 
 from __future__ import annotations
 
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -231,15 +234,56 @@ class Reference:
     color: np.ndarray  # (N, 3) sRGB in [0, 1], shaded at the reference uv
 
 
-def reference(view: View, max_pixels: int) -> Reference:
+def reference(view: View, max_pixels: int, hit=None) -> Reference:
+    """The float64 exact hits of the evaluated pixels (``hit``: already computed by ``exact_hit`` on
+    ``reference_rays``) and the image shaded at them."""
     rows, cols = (a.ravel() for a in eval_grid(view.size, max_pixels))
-    material = view.scene.materials["relief"]
-    depth = textures.load_depth(material.height)  # exactly what the GPU depth texture holds
-    hit = exact_hit(depth, view.uv0[rows, cols], view.v_ts[rows, cols], HEIGHT_SCALE)
+    if hit is None:
+        hit = exact_hit(*reference_rays(view, max_pixels))
     shader = Shader(view)
     color = np.full((len(rows), 3), np.nan)
     color[hit.valid] = shader(hit.uv[hit.valid])
     return Reference(rows, cols, hit.uv, hit.valid, color)
+
+
+def reference_rays(view: View, max_pixels: int) -> tuple:
+    """``exact_hit``'s arguments for the evaluated pixels: depth exactly as the GPU depth texture holds it, entry
+    uv, view vectors, height scale."""
+    rows, cols = (a.ravel() for a in eval_grid(view.size, max_pixels))
+    depth = textures.load_depth(view.scene.materials["relief"].height)
+    return depth, view.uv0[rows, cols], view.v_ts[rows, cols], HEIGHT_SCALE
+
+
+class _Later:
+    """A reference computed when first asked for (no pool)."""
+
+    def __init__(self, view: View, max_pixels: int):
+        self.view, self.max_pixels = view, max_pixels
+
+    def result(self) -> Reference:
+        return reference(self.view, self.max_pixels)
+
+
+class _Pooled:
+    def __init__(self, view: View, max_pixels: int, future):
+        self.view, self.max_pixels, self.future = view, max_pixels, future
+
+    def result(self) -> Reference:
+        return reference(self.view, self.max_pixels, self.future.result())
+
+
+def reference_pool(views: list[View], max_pixels: int, workers: int) -> list:
+    """One pending reference per view, in order (``.result()`` gives the Reference). ``workers`` > 0: the exact hits
+    are computed in that many processes (spawned: the GPU device is not forked), all submitted now; -1: one per
+    CPU core but one, at most 8; 0: each in this process when asked for."""
+    if workers < 0:
+        workers = min(8, max(1, (os.cpu_count() or 2) - 1))
+    if workers == 0 or not views:
+        return [_Later(v, max_pixels) for v in views]
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+    pending = [_Pooled(v, max_pixels, pool.submit(exact_hit, *reference_rays(v, max_pixels))) for v in views]
+    pool.shutdown(wait=False)  # the workers finish the submitted work, then exit
+    return pending
 
 
 class Shader:

@@ -131,6 +131,7 @@ _TEXEL = {  # format -> (numpy dtype, channels)
     "r32float": (np.float32, 1),
     "r16float": (np.float16, 1),
     "rgba16float": (np.float16, 4),
+    "rgba32float": (np.float32, 4),
     "rgba8unorm": (np.uint8, 4),
     "rgba8unorm-srgb": (np.uint8, 4),
 }

@@ -46,11 +46,15 @@ def simd_tile_cost(fetches: np.ndarray, tile: tuple[int, int] = SIMD_TILE, cover
     tw, th = tile
     if tw < 1 or th < 1:
         raise InputError(f"simd_tile_cost: tile = {tile}: expected positive (width, height)")
-    mask = np.ones(f.shape, bool) if covered is None else np.asarray(covered, bool)
     h, w = f.shape
+    if covered is not None and not np.all(covered):
+        f = np.where(np.asarray(covered, bool), f, -np.inf)
     ph, pw = -h % th, -w % tw
-    f = np.pad(np.where(mask, f, -np.inf), ((0, ph), (0, pw)), constant_values=-np.inf)
-    peaks = f.reshape((h + ph) // th, th, (w + pw) // tw, tw).max(axis=(1, 3))
+    if ph or pw:
+        f = np.pad(f, ((0, ph), (0, pw)), constant_values=-np.inf)
+    rows, cols = (h + ph) // th, (w + pw) // tw
+    # the tile rows' maxima first, then along each row: the same maxima, several times faster than max(axis=(1, 3))
+    peaks = f.reshape(rows, th, cols * tw).max(axis=1).reshape(rows, cols, tw).max(axis=2)
     used = peaks[np.isfinite(peaks)]
     return float(used.mean()) if used.size else float("nan")
 

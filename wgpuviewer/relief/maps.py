@@ -20,6 +20,7 @@ from maptools.cache import cached_generate
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 
+from . import autotable
 from .techniques import REFINED_MAX_ANGLE
 
 
@@ -35,6 +36,9 @@ class MapSlot:
     scale_bound: bool = False
     #: WGSL variable (default NAME_tex); slots that are alternatives for one tracer may share it.
     variable: str = ""
+    #: Built by measuring techniques on the depth map: ``build`` then takes the probe function as a fifth
+    #: argument (the renderer and the probe pass ``probe.probe``; this module cannot import it).
+    measured: bool = False
 
     @property
     def wgsl_name(self) -> str:
@@ -87,6 +91,81 @@ def _maxmip(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgp
     return create_texture(gpu, [maxmip_atlas(levels)], "r32float", label)
 
 
+#: Quantisation of the quadmax leaves: 14-bit depths q = floor(D * 16383), 9 of them in one rgba32uint texel.
+LEAF_BITS = 14
+LEAF_SCALE = (1 << LEAF_BITS) - 1
+
+
+def pack_leaves(depth: np.ndarray) -> np.ndarray:
+    """One rgba32uint texel (uint32 (ceil(H/2), ceil(W/2), 4)) per 2x2-cell block: the 9 texel depths D of texels
+    (2i + a, 2j + b), a, b in 0..2 (wrap), as 14-bit q = floor(D * 16383 - 2^-8) (so q / 16383 <= D even after
+    float32 rounding: the leaves' surface is never below the true one), value k = 3 b + a at bits [14 k, 14 k + 14)
+    of the 128-bit little-endian word sequence (quadmax.wgsl's leaf_depth)."""
+    d = np.asarray(depth, np.float64)
+    h, w = d.shape
+    bh, bw = (h + 1) // 2, (w + 1) // 2
+    q = np.clip(np.floor(d * LEAF_SCALE - 2.0 ** -8), 0, LEAF_SCALE).astype(np.uint64)
+    rows, cols = np.arange(bh) * 2, np.arange(bw) * 2
+    words = np.zeros((bh, bw, 4), np.uint64)
+    for k in range(9):
+        b, a = divmod(k, 3)
+        value = q[np.ix_((rows + b) % h, (cols + a) % w)]
+        bit = LEAF_BITS * k
+        word, shift = divmod(bit, 32)
+        words[:, :, word] |= (value << np.uint64(shift)) & np.uint64(0xFFFFFFFF)
+        if shift + LEAF_BITS > 32:
+            words[:, :, word + 1] |= value >> np.uint64(32 - shift)
+    return words.astype(np.uint32)
+
+
+def quadmax_atlas(depth: np.ndarray, levels: list[np.ndarray]) -> np.ndarray:
+    """The quadmax tracer's atlas, uint32 (rows, ceil(W/2), 4) for rgba32uint: node level 1 (2x2 cells) at rows
+    [0, h_1) holds the packed leaves (``pack_leaves``); level m >= 2 (sizes ceil-halving down to 1x1) at rows
+    [h_1 + ... + h_{m-1}, + h_m) holds per node P the maxima (float32 bits) of its four children at level m - 1,
+    (2P + (0,0), (1,0), (0,1), (1,1)) in x, y, z, w: one fetch tells which children a ray can skip. ``levels``:
+    maptools' maxmip of ``cell_max_height(depth)`` (level m bounds the cells [i 2^m, (i + 1) 2^m) from above).
+    A 1x1 map still gets level 1 (one leaf)."""
+    leaves = pack_leaves(depth)
+    levels = list(levels) + [levels[-1]] * (len(levels) < 2)  # 1x1: level 1 = level 0
+    parts = [leaves]
+    for m in range(2, len(levels)):
+        child = levels[m - 1]
+        ph, pw = levels[m].shape
+        quad = np.zeros((ph, pw, 4), np.float32)
+        for c, (dy, dx) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
+            part = child[dy::2, dx::2]
+            quad[:part.shape[0], :part.shape[1], c] = part
+        parts.append(quad.view(np.uint32))
+    atlas = np.zeros((sum(p.shape[0] for p in parts), leaves.shape[1], 4), np.uint32)
+    row = 0
+    for part in parts:
+        atlas[row:row + part.shape[0], :part.shape[1]] = part
+        row += part.shape[0]
+    return atlas
+
+
+def _uint_texture(gpu: Gpu, data: np.ndarray, label: str) -> wgpu.GPUTexture:
+    h, w = data.shape[:2]
+    limit = gpu.adapter.limits["max-texture-dimension-2d"]
+    if max(w, h) > limit:
+        raise UserError(f"{label}: texture of {w}x{h} exceeds this adapter's limit of {limit} texels per side")
+    data = np.ascontiguousarray(data, np.uint32)
+    texture = gpu.device.create_texture(label=label, size=(w, h, 1), format="rgba32uint",
+                                        usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST)
+    gpu.device.queue.write_texture({"texture": texture, "mip_level": 0, "origin": (0, 0, 0)}, data,
+                                   {"offset": 0, "bytes_per_row": w * 16, "rows_per_image": h}, (w, h, 1))
+    return texture
+
+
+def _quadmax(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    levels = cached_generate("maxmip", cell_max_height(depth), backend="auto")
+    return _uint_texture(gpu, quadmax_atlas(depth, levels), label)
+
+
+def _auto_table(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str, probe) -> wgpu.GPUTexture:
+    return autotable.table_texture(gpu, autotable.measure(depth, height_scale, probe), label)
+
+
 def _volume_texture(gpu: Gpu, volume: np.ndarray, label: str) -> wgpu.GPUTexture:
     dz, h, w = volume.shape
     limit = gpu.adapter.limits["max-texture-dimension-3d"]
@@ -134,6 +213,7 @@ DISTANCE_SLICES = 16
 _FILTERABLE_2D = {"texture": {"sample_type": "float", "view_dimension": "2d"}}
 _UNFILTERABLE_2D = {"texture": {"sample_type": "unfilterable-float", "view_dimension": "2d"}}
 _VOLUME = {"texture": {"sample_type": "unfilterable-float", "view_dimension": "3d"}}
+_UINT_2D = {"texture": {"sample_type": "uint", "view_dimension": "2d"}}
 _2D, _3D = "texture_2d<f32>", "texture_3d<f32>"
 
 MAP_SLOTS: dict[str, MapSlot] = {
@@ -152,6 +232,11 @@ MAP_SLOTS: dict[str, MapSlot] = {
                 "visibility-refined distance volume, same layout", scale_bound=True, variable="distance_tex"),
         MapSlot("cone", _2D, _UNFILTERABLE_2D, _cone,
                 "relaxed cone ratios (r32float), texels of u per unit t, textureLoad"),
+        MapSlot("quadmax", "texture_2d<u32>", _UINT_2D, _quadmax,
+                "max quadtree atlas (rgba32uint): packed 14-bit leaves (level 1), children's maxima (levels >= 2)"),
+        MapSlot("auto_table", _2D, _UNFILTERABLE_2D, _auto_table,
+                "auto's choices (rgba32float, bins x budget levels): candidate, method, parameter, error",
+                scale_bound=True, measured=True),
     )
 }
 

@@ -173,7 +173,9 @@ def _trace(tech, values: dict, height: np.ndarray, uv: np.ndarray, view: np.ndar
         label="probe:params", data=pack_trace_params(tech, height_scale, height.shape, values), usage=S.UNIFORM
     )
     depth = 1.0 - height
-    maps = [(name, MAP_SLOTS[name].build(gpu, depth, height_scale, f"probe:{name}")) for name in _derived(tech)]
+    maps = [(name, MAP_SLOTS[name].build(gpu, depth, height_scale, f"probe:{name}",
+                                         *((probe,) if MAP_SLOTS[name].measured else ())))
+            for name in _derived(tech)]
     mode = wgpu.AddressMode.repeat if address == "repeat" else wgpu.AddressMode.clamp_to_edge
     sampler = device.create_sampler(
         label="probe:sampler", address_mode_u=mode, address_mode_v=mode, mag_filter="linear", min_filter="linear"

@@ -10,6 +10,7 @@ resource it builds, so tests (and curious users) can see exactly what a scene co
 from __future__ import annotations
 
 import contextlib
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -23,9 +24,11 @@ from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 from wgpuviewer.scene import Camera, Scene
 
+from . import autotable
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_entries
+from .probe import probe
 from .shaders import MAX_LIGHTS, compose_technique, pack_trace_params, trace_params_size
-from .techniques import Technique, get_technique, resolve_params
+from .techniques import AUTO_CANDIDATES, Technique, get_technique, resolve_params
 
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
 DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, depth, fetches
@@ -36,6 +39,10 @@ FRAME_SIZE = 64 + 16 + 32 + MAX_LIGHTS * 32
 
 #: Frame.mode values (render.wgsl).
 MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4}
+
+#: Draw configurations whose uniform buffer and bind group are kept per material (the least recently drawn are
+#: dropped): draws with different parameters can share one submit (the A/B split, the benchmark's batched frames).
+MAX_DRAW_GROUPS = 64
 
 #: Formats of the material textures the renderer loads itself (the height-derived ones come from maps.py).
 _MATERIAL_FORMATS = {"albedo": "rgba16float", "normal": "rgba8unorm"}
@@ -75,30 +82,36 @@ class OffscreenImage:
 
 
 class Renderer:
-    def __init__(self, scene: Scene, gpu: Gpu):
+    def __init__(self, scene: Scene, gpu: Gpu, like: Renderer | None = None):
+        """``like``: a renderer of a scene with the same materials (the benchmark's views of one height map) whose
+        material textures, bind-group layouts, sampler and pipelines this one shares instead of building its own."""
         self.scene = scene
         self.gpu = gpu
         self.created: list[str] = []  # GPU resources built, in order: "kind:name"
-        self._textures: dict[tuple[str, str], wgpu.GPUTexture] = {}
-        self._pipelines: dict[tuple, wgpu.GPURenderPipeline] = {}
-        self._material_groups: dict[tuple[str, str], tuple[wgpu.GPUBindGroup, wgpu.GPUBuffer]] = {}
-        self._material_layouts: dict[tuple[str, ...], wgpu.GPUBindGroupLayout] = {}
+        self._material_groups: OrderedDict[tuple, tuple[wgpu.GPUBindGroup, wgpu.GPUBuffer]] = OrderedDict()
         device = gpu.device
         U = wgpu.BufferUsage
         V, F = wgpu.ShaderStage.VERTEX, wgpu.ShaderStage.FRAGMENT
+        if like is not None:
+            self._textures, self._pipelines, self._material_layouts = like._textures, like._pipelines, like._material_layouts
+            self._frame_layout, self._object_layout, self._sampler = like._frame_layout, like._object_layout, like._sampler
+        else:
+            self._textures: dict[tuple[str, str], wgpu.GPUTexture] = {}
+            self._pipelines: dict[tuple, wgpu.GPURenderPipeline] = {}
+            self._material_layouts: dict[tuple[str, ...], wgpu.GPUBindGroupLayout] = {}
+            self._frame_layout = device.create_bind_group_layout(
+                label="frame", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
+            )
+            self._object_layout = device.create_bind_group_layout(
+                label="object", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
+            )
+            self._sampler = device.create_sampler(
+                label="material", address_mode_u="repeat", address_mode_v="repeat",
+                mag_filter="linear", min_filter="linear", mipmap_filter="linear", max_anisotropy=1,
+            )
         self._frame_buffer = device.create_buffer(label="frame", size=FRAME_SIZE, usage=U.UNIFORM | U.COPY_DST)
-        self._frame_layout = device.create_bind_group_layout(
-            label="frame", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
-        )
         self._frame_group = device.create_bind_group(
             layout=self._frame_layout, entries=[{"binding": 0, "resource": {"buffer": self._frame_buffer}}]
-        )
-        self._object_layout = device.create_bind_group_layout(
-            label="object", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
-        )
-        self._sampler = device.create_sampler(
-            label="material", address_mode_u="repeat", address_mode_v="repeat",
-            mag_filter="linear", min_filter="linear", mipmap_filter="linear", max_anisotropy=1,
         )
         self._objects = [self._build_object(i, obj) for i, obj in enumerate(scene.objects)]
 
@@ -148,8 +161,9 @@ class Renderer:
             slot = MAP_SLOTS[kind]
             if slot.derived:
                 depth = self._depth_data(material)
+                measured = (probe,) if slot.measured else ()  # auto's table: measured with the probe
                 with _reported_against_height(material, kind):
-                    self._textures[key] = slot.build(self.gpu, depth, material.height_scale, label)
+                    self._textures[key] = slot.build(self.gpu, depth, material.height_scale, label, *measured)
             else:
                 if kind == "normal":
                     data = self._normal_data(material)  # our own copy: encoded in place, n * 0.5 + 0.5
@@ -161,6 +175,11 @@ class Renderer:
                 del data
             self.created.append(f"texture:{label}")
         return self._textures[key]
+
+    def auto_table(self, material_name: str) -> np.ndarray:
+        """auto's measurements on a material (relief/autotable.py): from the disk cache once auto has drawn it."""
+        material = self.scene.materials[material_name]
+        return autotable.measure(self._depth_data(material), material.height_scale, probe)
 
     @staticmethod
     def _depth_data(material) -> np.ndarray:
@@ -196,24 +215,30 @@ class Renderer:
             )
         return self._material_layouts[technique.textures]
 
-    def _material_group(self, material_name: str, technique: Technique):
-        key = (material_name, technique.name)
-        if key not in self._material_groups:
-            device = self.gpu.device
-            params = device.create_buffer(
-                label=f"params:{material_name}:{technique.name}",
-                size=trace_params_size(technique),
-                usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST,
-            )
-            entries = [{"binding": PARAMS_BINDING, "resource": {"buffer": params}},
-                       {"binding": SAMPLER_BINDING, "resource": self._sampler}]
-            entries += [
-                {"binding": binding(t), "resource": self.texture(material_name, t).create_view()}
-                for t in technique.textures
-            ]
-            group = device.create_bind_group(layout=self._material_layout(technique), entries=entries)
-            self._material_groups[key] = (group, params)
-        return self._material_groups[key]
+    def _material_group(self, material_name: str, technique: Technique, draw: DrawConfig):
+        """Bind group and uniform buffer of one draw configuration on one material (its own buffer, so draws with
+        other parameters recorded into the same submit keep theirs)."""
+        key = (material_name, draw.technique, draw.params, draw.height_scale)
+        if key in self._material_groups:
+            self._material_groups.move_to_end(key)
+            return self._material_groups[key]
+        device = self.gpu.device
+        params = device.create_buffer(
+            label=f"params:{material_name}:{technique.name}",
+            size=trace_params_size(technique),
+            usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST,
+        )
+        entries = [{"binding": PARAMS_BINDING, "resource": {"buffer": params}},
+                   {"binding": SAMPLER_BINDING, "resource": self._sampler}]
+        entries += [
+            {"binding": binding(t), "resource": self.texture(material_name, t).create_view()}
+            for t in technique.textures
+        ]
+        group = device.create_bind_group(layout=self._material_layout(technique), entries=entries)
+        self._material_groups[key] = (group, params)
+        if len(self._material_groups) > MAX_DRAW_GROUPS:
+            self._material_groups.popitem(last=False)
+        return group, params
 
     def pipeline(self, technique: Technique, formats: tuple[str, ...]) -> wgpu.GPURenderPipeline:
         key = (technique.name, formats)
@@ -314,7 +339,7 @@ class Renderer:
         pipeline = self.pipeline(technique, formats)
         groups = {}
         for material_name in {m for m, *_ in self._objects}:
-            group, params_buffer = self._material_group(material_name, technique)
+            group, params_buffer = self._material_group(material_name, technique, draw)
             material = self.scene.materials[material_name]
             depth_shape = self.texture(material_name, "depth").size[1::-1] if technique.needs_depth else (1, 1)
             height_scale = material.height_scale if draw.height_scale is None else draw.height_scale
@@ -391,7 +416,10 @@ def _reported_against_height(material, kind: str):
 
 
 def layer_range(params: dict) -> tuple[float, float]:
-    """(lo, hi) of the layers mode's grey (N - lo) / (hi - lo) (render.wgsl's layer_grey gets them in Frame)."""
+    """(lo, hi) of the layers mode's grey (N - lo) / (hi - lo) (render.wgsl's layer_grey gets them in Frame).
+    auto reports its chosen candidate (1-based, cheapest first) instead of a layer count."""
+    if "max_error" in params:
+        return 1.0, float(len(AUTO_CANDIDATES))
     if params.get("max_layers", 0) > 0:
         return float(params.get("min_layers", 0)), float(params["max_layers"])
     return 0.0, float(max(params.get("layers", 0), params.get("linear_steps", 0), 1))

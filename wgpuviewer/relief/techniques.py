@@ -25,6 +25,9 @@ COMMON_COST_SCALE = 64.0
 #: Hard cap on any layer count (generated into every technique's WGSL as ``MAX_LAYERS``).
 MAX_LAYERS = 1024
 
+#: quadmax's default step cap (auto's quadmax candidate runs with it too).
+QUADMAX_STEPS = 1024
+
 
 @dataclass(frozen=True)
 class Param:
@@ -109,6 +112,28 @@ class Technique:
 #: (maps.py passes it to maptools' distance_refined kind); steeper rays get no refined steps (see distance.wgsl).
 REFINED_MAX_ANGLE = 80.0
 
+
+
+#: ``auto``'s candidates, cheapest first: (technique, parameter overrides). The shader runs each one's code
+#: (basic: the entry point; parallax; pom_search with the layer count; quadmax_search with the top offset); the
+#: probe measures each one as that technique (relief/autotable.py).
+AUTO_CANDIDATES: tuple[tuple[str, dict], ...] = (
+    ("basic", {}), ("parallax", {}),
+    *(("pom", {"layers": n}) for n in (4, 8, 16, 32, 64)),
+    ("quadmax", {}),
+)
+#: auto's method ids in its table (auto.wgsl switches on them).
+AUTO_METHODS = {"basic": 0, "parallax": 1, "pom": 2, "quadmax": 3}
+#: auto's view-angle bins: bin 0 is tan(angle) < AUTO_TAN0, bin i + 1 is [tan0 2^(i/k), tan0 2^((i+1)/k)) with
+#: k = AUTO_BINS_PER_OCTAVE, up to AUTO_BINS bins (the last one open-ended): the search cost follows the ray's
+#: reach tan(angle) * S * W, so the bins are even in its logarithm (about 88.7 degrees at the last edge).
+AUTO_TAN0 = 2.0 ** -8
+AUTO_BINS_PER_OCTAVE = 2
+AUTO_BINS = 29
+#: auto's error budgets (texels): 2^(AUTO_BUDGET_LOG2_MIN + j), j < AUTO_BUDGET_LEVELS; max_error picks the largest
+#: one not above it.
+AUTO_BUDGET_LOG2_MIN = -4
+AUTO_BUDGET_LEVELS = 8
 
 
 def _layer_search(name: str, key: str, description: str) -> Technique:
@@ -200,6 +225,36 @@ TECHNIQUES: dict[str, Technique] = {
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
             ray_search=True, wgsl="distance.wgsl", fetch_bound=lambda p: 2 * p["iterations"], exact=True,
             fixed=(("cone_cos", math.cos(math.radians(REFINED_MAX_ANGLE))),),
+        ),
+        Technique(
+            "quadmax", "-",
+            "Max-quadtree tracing (maxmip with three changes): the walk starts at level floor(log2(reach in texels)) "
+            "+ top_offset, a node texel holds its four children's maxima (moving to a sibling or back up is free), and "
+            "a 2x2-cell leaf packs its 9 depths (14-bit, rounded towards the top) in one texel, solved exactly per "
+            "cell. Never behind the first hit; early by at most the 6e-5 depth quantisation.",
+            "one atlas texel per quad node read + one per leaf (at most 2 per step)",
+            ("albedo", "normal", "depth", "quadmax"),
+            (
+                Param("top_offset", -2, -8, 8, int, "start level = floor(log2(ray reach in texels)) + this (>= 1)"),
+                Param("max_steps", QUADMAX_STEPS, 1, 65536, int, "cap on traversal steps (capped rays are flagged)"),
+            ),
+            ray_search=True, fetch_bound=lambda p: 2 * p["max_steps"],
+        ),
+        Technique(
+            "auto", "-",
+            "The error budget as a technique: per pixel, the view angle picks the cheapest candidate (basic, "
+            "parallax, POM 4-64 layers, quadmax) whose p97.5 UV error the probe measured within max_error on this "
+            "material's own height map, at both ends of the angle bin (relief/autotable.py; cached with the maps).",
+            "the chosen candidate's fetches (one table texel, not counted)",
+            ("albedo", "normal", "depth", "quadmax", "auto_table"),
+            (Param("max_error", 0.5, 2.0 ** AUTO_BUDGET_LOG2_MIN, 2.0 ** (AUTO_BUDGET_LOG2_MIN + AUTO_BUDGET_LEVELS - 1),
+                   float, "UV error budget in texels (the table's budgets are powers of 2: the largest one not "
+                   "above this is used)"),),
+            ray_search=True,
+            fixed=(("bin_tan0", AUTO_TAN0), ("bins_per_octave", float(AUTO_BINS_PER_OCTAVE)),
+                   ("budget_log2_min", float(AUTO_BUDGET_LOG2_MIN)), ("quadmax_steps", float(QUADMAX_STEPS))),
+            fetch_bound=lambda p: max(TECHNIQUES[name].fetch_bound(resolve_params(TECHNIQUES[name], params))
+                                      for name, params in AUTO_CANDIDATES if TECHNIQUES[name].ray_search),
         ),
         Technique(
             "cone", "-",

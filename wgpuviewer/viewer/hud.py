@@ -14,9 +14,12 @@ except ImportError:  # the viewer then runs without a HUD (window title only)
     imgui = None
     ImguiRenderer = None
 
+import functools
+
 import numpy as np
 
 from wgpuviewer.core.color import heat, linear_to_srgb
+from wgpuviewer.relief import autotable
 from wgpuviewer.relief.maps import height_scale_adjustable
 from wgpuviewer.relief.techniques import get_technique
 
@@ -31,6 +34,17 @@ GREY = (0.7, 0.7, 0.7, 1.0)
 MARGIN = 8.0
 #: Below this window size (logical pixels) the HUD is compact.
 COMPACT_SIZE = (640, 400)
+
+
+@functools.lru_cache(maxsize=16)
+def auto_lines(renderer, max_error: float) -> list[str]:
+    """What auto chooses per view-angle range at ``max_error`` on each material of the renderer's scene (from its
+    measured table; the layers view, --mode layers, paints the candidate numbers)."""
+    lines = [f"auto at max_error {max_error:g}: budget {autotable.budgets()[autotable.budget_level(max_error)]:g} texel"]
+    for name in renderer.scene.materials:
+        lines.append(f"{name}:")
+        lines += [f"  {line}" for line in autotable.describe(renderer.auto_table(name), max_error)]
+    return lines
 
 
 class Hud:
@@ -171,6 +185,9 @@ class Hud:
             imgui.text_colored(GREY, t.description)
             imgui.pop_text_wrap_pos()
             self._params(name, tag)
+            if t.name == "auto":
+                for line in auto_lines(v.renderer, v.technique_params(name)["max_error"]):
+                    imgui.text_colored(GREY, line)
             imgui.separator()
         modes = ("color", "cost", "error")
         for i, mode in enumerate(modes):

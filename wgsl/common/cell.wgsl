@@ -1,6 +1,7 @@
-// The exact solve of one bilinear cell (maxmip, distance; the float64 twin is wgpuviewer/relief/reference.py)
-// and where a ray leaves a box of cells.
+// The exact solve of one bilinear cell (maxmip, distance, quadmax; the float64 twin is wgpuviewer/relief/reference.py),
+// where a ray leaves a box of cells, and the nodes of the pyramid walks (maxmip, quadmax).
 // #include "common/depth.wgsl"
+// #include "common/wrap.wgsl"
 
 // Smallest s in [0, len] with a s^2 + b s + c = 0 given c < 0 (f = t - D below zero at s = 0), or -1.
 // Cancellation-free pair q/a, c/q; a == 0 (linear) falls out as -c/b. Roots a rounding error past the
@@ -36,10 +37,15 @@ fn cell_hit(cell: vec2i, start: vec2f, dir: vec2f, t0: f32, t1: f32) -> f32 {
     let size = vec2f(textureDimensions(depth_tex, 0));
     // Gather order: (umin, vmax), (umax, vmax), (umax, vmin), (umin, vmin).
     let g = textureGather(0, depth_tex, material_sampler, (vec2f(cell) + 1.0) / size);
-    let c00 = g.w;
-    let c10 = g.z;
-    let c01 = g.x;
-    let c11 = g.y;
+    return cell_root(vec4f(g.w, g.z, g.x, g.y), cell, start, dir, t0, t1);
+}
+
+// cell_hit's solve for given corner depths c = (c00, c10, c01, c11) (x = +u, y = +v): no fetch.
+fn cell_root(c: vec4f, cell: vec2i, start: vec2f, dir: vec2f, t0: f32, t1: f32) -> f32 {
+    let c00 = c.x;
+    let c10 = c.y;
+    let c01 = c.z;
+    let c11 = c.w;
     let bx = c10 - c00;
     let cy = c01 - c00;
     let exy = c11 - c10 - c01 + c00;
@@ -66,4 +72,33 @@ fn box_exit(start: vec2f, dir: vec2f, lo: vec2f, hi: vec2f) -> vec2f {
     if dir.x > 0.0 { r.x = (hi.x - start.x) / dir.x; } else if dir.x < 0.0 { r.x = (lo.x - start.x) / dir.x; }
     if dir.y > 0.0 { r.y = (hi.y - start.y) / dir.y; } else if dir.y < 0.0 { r.y = (lo.y - start.y) / dir.y; }
     return r;
+}
+
+// The cell the ray enters when it leaves the box [lo, hi) of cells at t_exit (exits: where it crosses the box's x and
+// y sides; through a corner both indices move). Integer state: rounding can never make a walk stall or go back.
+fn next_cell(start: vec2f, dir: vec2f, t_exit: f32, exits: vec2f, lo: vec2i, hi: vec2i) -> vec2i {
+    let p = floor(start + t_exit * dir);
+    return vec2i(
+        select(clamp(i32(p.x), lo.x, hi.x - 1), select(lo.x - 1, hi.x, dir.x > 0.0), exits.x <= t_exit),
+        select(clamp(i32(p.y), lo.y, hi.y - 1), select(lo.y - 1, hi.y, dir.y > 0.0), exits.y <= t_exit),
+    );
+}
+
+// A node of a pyramid walk: level m holds 2^m x 2^m cells, clipped at the map's edge (size wh cells, repeat).
+struct WalkNode {
+    index: vec2i,   // the node's (wrapped) index at its level
+    lo: vec2i,      // its cells [lo, hi), unwrapped like the cell it was found from
+    hi: vec2i,
+    exits: vec2f,   // where the ray start + t * dir leaves them across x and across y
+    t_exit: f32,    // the first of the two, at most 1
+}
+
+fn walk_node(cell: vec2i, level: u32, wh: vec2i, start: vec2f, dir: vec2f) -> WalkNode {
+    let wrapped = wrap_texel(cell, wh);
+    let index = wrapped >> vec2u(level);
+    let first = index << vec2u(level);
+    let lo = cell - wrapped + first;
+    let hi = lo + min(vec2i(1 << level), wh - first);
+    let exits = box_exit(start, dir, vec2f(lo), vec2f(hi));
+    return WalkNode(index, lo, hi, exits, min(min(exits.x, exits.y), 1.0));
 }

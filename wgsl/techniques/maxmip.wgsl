@@ -15,7 +15,6 @@
 // never make the walk stall or go back. Bounded by max_steps (capped rays are flagged).
 // Addressing: the pyramid wraps (repeat), as the renderer's sampler does.
 // #include "common/cell.wgsl"
-// #include "common/wrap.wgsl"
 
 const MAXMIP_LEVELS: u32 = 16u;
 // Float32 rounding of the stored maxima (height -> depth): skip only with this much room to spare.
@@ -43,33 +42,23 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     var level = top;
     let cap = u32(clamp(trace_params.max_steps, 1.0, MAX_STEPS_MAX));
     for (var step = 0u; step < cap; step++) {
-        let wrapped = wrap_texel(cell, wh);
-        let node = wrapped >> vec2u(level);
-        let first = node << vec2u(level);
-        let lo = cell - wrapped + first;                           // the node's cells, unwrapped
-        let hi = lo + min(vec2i(1 << level), wh - first);
-        let exits = box_exit(start, dir, vec2f(lo), vec2f(hi));
-        let t_exit = min(min(exits.x, exits.y), 1.0);
+        let n = walk_node(cell, level, wh, start, dir);
         if level > 0u {
             fetch_count += 1u;
-            let top_height = textureLoad(maxmip_tex, vec2i(node.x, rows[level] + node.y), 0).r;
-            if t_exit >= 1.0 - top_height - MAXMIP_MARGIN {
+            let top_height = textureLoad(maxmip_tex, vec2i(n.index.x, rows[level] + n.index.y), 0).r;
+            if n.t_exit >= 1.0 - top_height - MAXMIP_MARGIN {
                 level -= 1u;  // the ray may reach this node's relief: look closer
                 continue;
             }
         } else {
-            let t_hit = cell_hit(cell, start, dir, t, t_exit);
+            let t_hit = cell_hit(cell, start, dir, t, n.t_exit);
             if t_hit >= 0.0 {
                 return TraceResult(uv0 - span * t_hit, t_hit, fetch_count, is_grazing(v), 0u);
             }
         }
         // Nothing in this node: step into the next one along the ray and look from one level up.
-        t = max(t, t_exit);
-        let p = floor(start + t * dir);
-        cell = vec2i(
-            select(clamp(i32(p.x), lo.x, hi.x - 1), select(lo.x - 1, hi.x, dir.x > 0.0), exits.x <= t_exit),
-            select(clamp(i32(p.y), lo.y, hi.y - 1), select(lo.y - 1, hi.y, dir.y > 0.0), exits.y <= t_exit),
-        );
+        t = max(t, n.t_exit);
+        cell = next_cell(start, dir, t, n.exits, n.lo, n.hi);
         level = min(level + 1u, top);
     }
     return TraceResult(uv0 - span * t, t, fetch_count, true, 0u);

@@ -1,0 +1,226 @@
+"""``auto``'s cost/error table: the probe measures every candidate of ``techniques.AUTO_CANDIDATES`` on the material's
+own depth map at the edges of auto's view-angle bins; per bin and error budget the cheapest candidate that meets the
+budget at both edges of the bin is chosen, and the choices go to the GPU as a small texture (``table_texture``).
+
+Measurement (``measure``): at every angle (0 and the bin edges, ``edge_angles``) ``ERROR_RAYS`` independent random rays
+(entry points all over the map, random azimuths) for the error and ``TILES`` screen tiles of 8 x 4 rays for the cost
+(``tile_rays``: a random entry point and azimuth per tile, rays ``TILE_SPACING`` texels apart, like neighbouring
+pixels of a SIMD group); per candidate and angle the p95 and p97.5 UV error (texels) against the float64 exact hit
+(capped rays count as misses), the mean fetches and the SIMD-tile cost (mean over tiles of the tile's largest fetch
+count, ``accuracy.simd_tile_cost``'s definition) of the tiles. A candidate meets budget B in a bin when its p97.5 is within B at
+both edges (twice the margin the p95 budget asks for: the table's rays are a sample, and a view sees only part of
+the map); its cost there is the larger SIMD-tile cost of the two edges times ``COST_WEIGHTS`` (the time of one of
+its fetches in POM fetches). Where no candidate meets the budget, the most accurate one is used and the table says
+so (its error channel exceeds the budget).
+
+The measurements are cached on disk next to maptools' maps (content hash of the depth map + height scale +
+candidates, their WGSL code, the rays; ``maptools.cache``'s key and folder, kind ``auto_table``). This module gets
+the probe from its caller (maps.py's slot is "measured": the renderer and the probe pass ``probe.probe``), so it
+imports neither.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from maptools.cache import cache_key, cache_path
+from wgpuviewer.core.gpu import Gpu, create_texture
+from wgpuviewer.core.io import atomic_open
+from wgpuviewer.core.wgsl import compose
+
+from .reference import exact_hit, uv_error_texels, view_dir_from_angles
+from .techniques import (
+    AUTO_BINS,
+    AUTO_BINS_PER_OCTAVE,
+    AUTO_BUDGET_LEVELS,
+    AUTO_BUDGET_LOG2_MIN,
+    AUTO_CANDIDATES,
+    AUTO_METHODS,
+    AUTO_TAN0,
+    TECHNIQUES,
+)
+
+#: Bump when what ``measure`` computes changes (cached tables are then measured again).
+VERSION = 2
+ERROR_RAYS = 1024  # independent random rays per angle for the error
+TILES = 16  # screen tiles per angle for the cost
+TILE = (8, 4)  # rays per tile: across x along the view azimuth, like a SIMD group of 8 x 4 pixels
+TILE_SPACING = 0.75  # texels between neighbouring rays of a tile
+SEED = 13
+#: Time of one SIMD-tile fetch of each candidate in POM fetches, for choosing between candidates that meet a budget.
+#: Measured on llvmpipe (process CPU time of 96x54 to 192x108 frames, brick and bricks at 45 and 80 degrees): a
+#: quadmax fetch - a dependent 128-bit load, its unpacking, up to three quadratic solves - costs 1.9-3.5 POM fetches,
+#: median 3.2 (docs/techniques.md). The H100 run put the exact walks (maxmip, distance) at 6-12 POM fetches per
+#: fetch; a GPU run of the benchmark reports this per technique ("time per SIMD-tile fetch") to recalibrate.
+COST_WEIGHTS = {"basic": 1.0, "parallax": 1.0, "pom": 1.0, "quadmax": 3.0}
+#: Columns of a measurement: p95 and p97.5 UV error (texels), mean fetches, SIMD-tile cost, capped fraction.
+FIELDS = ("err_p95", "err_p975", "fetches_mean", "fetches_simd", "capped")
+
+
+def edge_angles() -> np.ndarray:
+    """The angles (degrees) the table is measured at: 0, then the bin edges atan(tan0 2^(i / k)), i < AUTO_BINS - 1."""
+    tans = AUTO_TAN0 * 2.0 ** (np.arange(AUTO_BINS - 1) / AUTO_BINS_PER_OCTAVE)
+    return np.concatenate([[0.0], np.degrees(np.arctan(tans))])
+
+
+def bin_of(angle_deg) -> np.ndarray:
+    """auto.wgsl's bin index of view angles (degrees): 0 below the first edge, then one per half octave of tan."""
+    tan = np.tan(np.radians(np.asarray(angle_deg, np.float64)))
+    with np.errstate(divide="ignore"):
+        b = np.floor(AUTO_BINS_PER_OCTAVE * np.log2(np.maximum(tan, 1e-300) / AUTO_TAN0)) + 1
+    return np.clip(np.where(tan < AUTO_TAN0, 0, b), 0, AUTO_BINS - 1).astype(np.int64)
+
+
+def budgets() -> np.ndarray:
+    return 2.0 ** (AUTO_BUDGET_LOG2_MIN + np.arange(AUTO_BUDGET_LEVELS))
+
+
+def tile_rays(angle_deg: float, shape: tuple[int, int], rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """``TILES`` tiles of 8 x 4 rays at one angle: uv (n, 2), view (n, 3); ray k of tile i is i * 32 + k (row-major
+    over the tile's 4 rows of 8)."""
+    h, w = shape
+    tw, th = TILE
+    origin = rng.random((TILES, 1, 2))
+    phi = rng.random(TILES) * 2 * np.pi
+    along = np.stack([np.cos(phi), np.sin(phi)], -1)[:, None, :]  # the view azimuth (screen y)
+    across = np.stack([-np.sin(phi), np.cos(phi)], -1)[:, None, :]  # screen x
+    j, i = np.divmod(np.arange(tw * th), tw)
+    offset = (i[None, :, None] * across + j[None, :, None] * along) * TILE_SPACING / np.array([w, h])
+    uv = (origin + offset).reshape(-1, 2)
+    view = view_dir_from_angles(np.full(TILES, angle_deg), np.degrees(phi))
+    return uv, np.repeat(view, tw * th, axis=0)
+
+
+def _measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndarray:
+    rng = np.random.default_rng(SEED)
+    angles = edge_angles()
+    n_err, n_cost = ERROR_RAYS, TILES * TILE[0] * TILE[1]
+    uv, view = [], []
+    for a in angles:
+        uv.append(rng.random((n_err, 2)))  # error rays: independent, all over the map
+        view.append(view_dir_from_angles(np.full(n_err, a), rng.random(n_err) * 360.0))
+        tiles = tile_rays(a, depth.shape, rng)  # cost rays: SIMD tiles
+        uv.append(tiles[0])
+        view.append(tiles[1])
+    uv, view = np.concatenate(uv), np.concatenate(view)
+    per_angle = n_err + n_cost
+    error_rays = (np.arange(len(uv)) % per_angle) < n_err
+    ref = exact_hit(depth, uv[error_rays], view[error_rays], height_scale)
+    out = np.zeros((len(AUTO_CANDIDATES), len(angles), len(FIELDS)))
+    height = 1.0 - np.asarray(depth, np.float64)
+    for c, (name, params) in enumerate(AUTO_CANDIDATES):
+        if TECHNIQUES[name].ray_search:
+            got = probe(name, height, uv, view, height_scale, **params)
+            hit_uv, fetches, capped = got.uv.astype(np.float64), got.fetches.astype(np.float64), got.capped
+        else:  # basic: the entry point, no fetch
+            hit_uv, fetches, capped = uv, np.zeros(len(uv)), np.zeros(len(uv), bool)
+        miss = capped[error_rays] | ~ref.valid
+        err = np.where(miss, np.inf, uv_error_texels(hit_uv[error_rays], np.nan_to_num(ref.uv), depth.shape[::-1]))
+        for a in range(len(angles)):
+            e = err[a * n_err:(a + 1) * n_err]
+            f = fetches[a * per_angle + n_err:(a + 1) * per_angle]
+            # the SIMD-tile cost: mean over the tiles of the tile's largest fetch count
+            out[c, a] = (np.percentile(e, 95), np.percentile(e, 97.5), f.mean(), f.reshape(TILES, -1).max(axis=1).mean(),
+                         capped[a * per_angle:(a + 1) * per_angle].mean())
+    return out
+
+
+def candidates_code() -> str:
+    """Hash of the candidates' WGSL (each technique file with what it includes): a cached table was measured with
+    exactly this code."""
+    h = hashlib.sha256()
+    for name in dict.fromkeys(name for name, _ in AUTO_CANDIDATES):
+        h.update(compose(TECHNIQUES[name].wgsl_file).code.encode())
+    return h.hexdigest()
+
+
+def measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndarray:
+    """The measurements (candidates, angles, FIELDS) of ``depth`` (D = 1 - height) at ``height_scale``, from the disk
+    cache when it holds them."""
+    d = np.ascontiguousarray(depth, np.float32)
+    options = {"height_scale": float(height_scale), "candidates": [[n, p] for n, p in AUTO_CANDIDATES],
+               "code": candidates_code(),
+               "angles": [float(a) for a in edge_angles()], "error_rays": ERROR_RAYS, "tiles": TILES, "tile": list(TILE),
+               "spacing": TILE_SPACING, "seed": SEED, "version": VERSION}
+    path = cache_path("auto_table", cache_key("auto_table", d, options))
+    if path.is_file():
+        try:
+            table = np.load(path, allow_pickle=False)
+            if table.shape == (len(AUTO_CANDIDATES), len(edge_angles()), len(FIELDS)):
+                return table
+        except (OSError, ValueError):  # a damaged cache entry is measured again
+            pass
+    table = _measure(d.astype(np.float64), height_scale, probe)
+    with atomic_open(path) as f:
+        np.save(f, table)
+    return table
+
+
+def choose(table: np.ndarray) -> np.ndarray:
+    """Per (budget level, bin): (candidate index, error at the worse edge, weighted cost, met) as float64
+    (AUTO_BUDGET_LEVELS, AUTO_BINS, 4)."""
+    err, simd = table[:, :, FIELDS.index("err_p975")], table[:, :, FIELDS.index("fetches_simd")]
+    weights = np.array([COST_WEIGHTS[name] for name, _ in AUTO_CANDIDATES])[:, None]
+    # bin b spans edges b and b + 1 (edge 0 = angle 0); the last bin is open-ended: its lower edge only
+    lo = np.arange(AUTO_BINS)
+    hi = np.minimum(lo + 1, AUTO_BINS - 1)
+    bin_err = np.maximum(err[:, lo], err[:, hi])
+    bin_cost = weights * np.maximum(simd[:, lo], simd[:, hi])
+    out = np.zeros((AUTO_BUDGET_LEVELS, AUTO_BINS, 4))
+    for j, budget in enumerate(budgets()):
+        for b in range(AUTO_BINS):
+            ok = np.flatnonzero(bin_err[:, b] <= budget)
+            c = int(ok[np.argmin(bin_cost[ok, b])]) if ok.size else int(np.argmin(bin_err[:, b]))
+            out[j, b] = (c, bin_err[c, b], bin_cost[c, b], float(ok.size > 0))
+    return out
+
+
+def texels(table: np.ndarray) -> np.ndarray:
+    """The table texture's texels, float32 (AUTO_BUDGET_LEVELS, AUTO_BINS, 4): candidate index, method id (auto.wgsl),
+    the method's parameter (POM layers, quadmax top_offset), the chosen candidate's error at the worse edge."""
+    choice = choose(table)
+    out = np.zeros(choice.shape, np.float32)
+    for j in range(AUTO_BUDGET_LEVELS):
+        for b in range(AUTO_BINS):
+            name, params = AUTO_CANDIDATES[int(choice[j, b, 0])]
+            value = params.get("layers", params.get("top_offset", TECHNIQUES[name].defaults().get("top_offset", 0)))
+            out[j, b] = (choice[j, b, 0], AUTO_METHODS[name], value, choice[j, b, 1])
+    return out
+
+
+def table_texture(gpu: Gpu, table: np.ndarray, label: str):
+    return create_texture(gpu, [texels(table)], "rgba32float", label)
+
+
+def budget_level(max_error: float) -> int:
+    """auto.wgsl's budget level for max_error: the largest budget 2^(min + j) not above it."""
+    return int(np.clip(math.floor(math.log2(max_error)) - AUTO_BUDGET_LOG2_MIN, 0, AUTO_BUDGET_LEVELS - 1))
+
+
+def candidate_label(index: int) -> str:
+    name, params = AUTO_CANDIDATES[index]
+    return " ".join([name, *(f"{k}={v}" for k, v in params.items())])
+
+
+def describe(table: np.ndarray, max_error: float) -> list[str]:
+    """One line per run of bins with the same choice at ``max_error``: angle range, candidate, worst p97.5, cost."""
+    level = budget_level(max_error)
+    choice = choose(table)[level]
+    edges = edge_angles()
+    lines, b = [], 0
+    while b < AUTO_BINS:
+        end = b
+        while end + 1 < AUTO_BINS and choice[end + 1, 0] == choice[b, 0]:
+            end += 1
+        lo = edges[b]
+        hi = f"{edges[end + 1]:.1f}°" if end + 1 < AUTO_BINS else "90°"
+        worst = float(choice[b:end + 1, 1].max())
+        met = "" if choice[b:end + 1, 3].all() else " (budget not met)"
+        lines.append(f"{lo:.1f}-{hi}: {candidate_label(int(choice[b, 0]))}, p97.5 <= {worst:.3g} texel, "
+                     f"cost <= {float(choice[b:end + 1, 2].max()):.3g}{met}")
+        b = end + 1
+    return lines

@@ -1,0 +1,54 @@
+// auto: the error budget as a technique. Per pixel the view angle picks a bin (bin 0: tan(angle) < bin_tan0;
+// then bins_per_octave bins per octave of tan(angle), the last one open-ended; grazing views take the last);
+// max_error picks a budget level (the largest 2^(budget_log2_min + j) not above it). The table
+// (relief/autotable.py: measured by the probe on this material's height map) holds per (bin, level) the
+// cheapest candidate within the budget: its index, method, parameter and measured error. The candidates are the
+// very code the techniques basic, parallax, pom and quadmax run (common/*.wgsl). `layers` reports the chosen
+// candidate (1-based, cheapest first) for the layers debug view. The table texel is not counted as a fetch.
+// #include "common/layer_march.wgsl"
+// #include "common/parallax.wgsl"
+// #include "common/quadmax.wgsl"
+
+const AUTO_BASIC: u32 = 0u;
+const AUTO_PARALLAX: u32 = 1u;
+const AUTO_POM: u32 = 2u;
+
+fn auto_choice(v: vec3f) -> vec4f {
+    let dims = vec2i(textureDimensions(auto_table_tex, 0));  // (bins, budget levels)
+    var bin = dims.x - 1;
+    if !is_grazing(v) {
+        let tan_view = length(v.xy) / v.z;
+        if tan_view < trace_params.bin_tan0 {
+            bin = 0;
+        } else {
+            let b = floor(trace_params.bins_per_octave * log2(tan_view / trace_params.bin_tan0)) + 1.0;
+            bin = i32(clamp(b, 0.0, f32(dims.x - 1)));
+        }
+    }
+    let budget = clamp(trace_params.max_error, MAX_ERROR_MIN, MAX_ERROR_MAX);
+    let level = i32(clamp(floor(log2(budget)) - trace_params.budget_log2_min, 0.0, f32(dims.y - 1)));
+    return textureLoad(auto_table_tex, vec2i(bin, level), 0);
+}
+
+fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
+    fetch_count = 0u;
+    let choice = auto_choice(v);
+    var r: TraceResult;
+    switch u32(choice.y) {
+        case AUTO_BASIC: {
+            r = untraced(uv0);
+        }
+        case AUTO_PARALLAX: {
+            r = parallax_offset(uv0, v, lod, false);
+        }
+        case AUTO_POM: {
+            r = pom_search(uv0, v, lod, u32(clamp(choice.z, 1.0, f32(MAX_LAYERS))));
+        }
+        default: {
+            r = quadmax_search(uv0, v, choice.z, u32(trace_params.quadmax_steps));
+        }
+    }
+    r.capped = r.capped || is_grazing(v);
+    r.layers = u32(choice.x) + 1u;
+    return r;
+}
