@@ -14,12 +14,17 @@ import wgpu
 
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu
-from wgpuviewer.core.wgsl import compose
+from wgpuviewer.core.wgsl import Generated, compose
 
 from .geometry import Spans, defined_range
 from .methods import METHODS, Method, Result, fixed_setup, split
 
 SOURCE = "studies/perspective/kernels.wgsl"
+#: Kernels that are forms of a shared entry point (one thread per pixel, or one per span walking it), with the
+#: value of its pipeline-overridable FORM (generated into the module as FORM_* constants).
+FORMS = {"direct": ("per_pixel", 0), "span": ("per_pixel", 1), "incremental": ("sequential", 2),
+         "reanchor": ("sequential", 3), "kahan": ("sequential", 4), "double_single": ("sequential", 5),
+         "fixed16_16": ("sequential", 6)}
 WORKGROUP = 64
 MAX_GROUPS = 65535  # per dispatch dimension
 PARAMS_SIZE = 6 * 16 + 16  # six vec4 + span_length, span_count, param, one (common.wgsl's Params)
@@ -67,7 +72,8 @@ class Kernels:
     def __init__(self, gpu: Gpu):
         self.gpu = gpu
         device = gpu.device
-        self.source = compose(SOURCE)
+        forms = "".join(f"const FORM_{name.upper()}: u32 = {form}u;\n" for name, (_, form) in FORMS.items())
+        self.source = compose(Generated("<generated: kernel forms>", forms), SOURCE)
         self.module = device.create_shader_module(label="perspective", code=self.source.code)
         C = wgpu.ShaderStage.COMPUTE
         storage = wgpu.BufferBindingType.storage
@@ -79,16 +85,20 @@ class Kernels:
         self.pipeline_layout = device.create_pipeline_layout(label="perspective", bind_group_layouts=[self.layout])
         self._pipelines: dict[str, wgpu.GPUComputePipeline] = {}
 
-    def pipeline(self, entry: str) -> wgpu.GPUComputePipeline:
-        if entry not in self._pipelines:
+    def pipeline(self, kernel: str) -> wgpu.GPUComputePipeline:
+        """The pipeline of a kernel: its own entry point, or the shared one specialised to its form."""
+        if kernel not in self._pipelines:
+            stage = {"module": self.module, "entry_point": kernel}
+            if kernel in FORMS:
+                entry, form = FORMS[kernel]
+                stage = {**stage, "entry_point": entry, "constants": {"FORM": form}}
             try:
-                self._pipelines[entry] = self.gpu.device.create_compute_pipeline(
-                    label=f"perspective:{entry}", layout=self.pipeline_layout,
-                    compute={"module": self.module, "entry_point": entry})
+                self._pipelines[kernel] = self.gpu.device.create_compute_pipeline(
+                    label=f"perspective:{kernel}", layout=self.pipeline_layout, compute=stage)
             except (wgpu.GPUValidationError, wgpu.GPUPipelineError) as exc:
-                raise UserError(f"perspective kernel {entry} failed to build on {self.gpu.summary}: "
+                raise UserError(f"perspective kernel {kernel} failed to build on {self.gpu.summary}: "
                                 f"{self.source.locate(str(exc))}") from None
-        return self._pipelines[entry]
+        return self._pipelines[kernel]
 
     def outputs(self, spans: Spans) -> Outputs:
         """Output buffers for ``spans`` (several dispatches may share them, e.g. for timing)."""

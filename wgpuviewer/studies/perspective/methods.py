@@ -272,7 +272,7 @@ class Method:
     family: str  # "paper" (the seed's formulas), "reference" (a practical point of comparison), "mitigation"
     summary: str
     evaluate: Callable[[Arith, np.ndarray, Spans], Result]
-    kernel: str  # WGSL entry point
+    kernel: str  # its WGSL kernel (an entry point, or a form of a shared one: kernels.FORMS)
     param: int = 0  # k, S or M
     precisions: tuple[str, ...] = ("float32", "float64")
     #: (adds, muls, divs) per texel for u and v together as the paper states them ("implied": by its formula)

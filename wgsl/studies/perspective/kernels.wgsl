@@ -5,15 +5,23 @@
 // (subdivided), numbered along x. Every loop is capped.
 // #include "studies/perspective/common.wgsl"
 
-// One thread per pixel: formula (1).
+// The forms of one kernel shape share an entry point; the pipeline-overridable FORM (kernels.py sets it per
+// method, with the FORM_* constants it generates) picks the form when the pipeline is created, so each form
+// compiles on its own, without a branch per pixel.
+override FORM: u32 = FORM_DIRECT;
+
+// One thread per pixel: formula (1) (direct), or formula (3) from the constants span_setup wrote (span).
 @compute @workgroup_size(64)
-fn direct(@builtin(global_invocation_id) gid: vec3u) {
+fn per_pixel(@builtin(global_invocation_id) gid: vec3u) {
     let n = gid.x;
     let s = gid.y;
     if n >= P.span_length || s >= P.span_count {
         return;
     }
-    store(s, n, linear(f32(spans[s].x0 + i32(n)), f32(spans[s].y)));
+    switch FORM {
+        case FORM_SPAN: { store(s, n, starts[s].xyz + P.a.xyz * f32(n)); }
+        default: { store(s, n, linear(f32(spans[s].x0 + i32(n)), f32(spans[s].y))); }
+    }
 }
 
 // One thread per span: the per-span constants for `span`.
@@ -25,24 +33,24 @@ fn span_setup(@builtin(global_invocation_id) gid: vec3u) {
     }
 }
 
-// One thread per pixel: formula (3), from the constants span_setup wrote.
+// One thread per span walks it from n = 0: formula (4) (incremental) and its mitigations.
 @compute @workgroup_size(64)
-fn span(@builtin(global_invocation_id) gid: vec3u) {
-    let n = gid.x;
-    let s = gid.y;
-    if n >= P.span_length || s >= P.span_count {
-        return;
-    }
-    store(s, n, starts[s].xyz + P.a.xyz * f32(n));
-}
-
-// One thread per span: formula (4).
-@compute @workgroup_size(64)
-fn incremental(@builtin(global_invocation_id) gid: vec3u) {
+fn sequential(@builtin(global_invocation_id) gid: vec3u) {
     let s = gid.x;
     if s >= P.span_count {
         return;
     }
+    switch FORM {
+        case FORM_REANCHOR: { reanchor(s); }
+        case FORM_KAHAN: { kahan(s); }
+        case FORM_DOUBLE_SINGLE: { double_single(s); }
+        case FORM_FIXED16_16: { fixed16_16(s); }
+        default: { incremental(s); }
+    }
+}
+
+// Formula (4).
+fn incremental(s: u32) {
     var w = span_start(s);
     for (var n = 0u; n < span_len(); n++) {
         store(s, n, w);
@@ -139,13 +147,8 @@ fn subdivided(@builtin(global_invocation_id) gid: vec3u) {
     }
 }
 
-// One thread per span: formula (4), with the span form afresh every M = P.param pixels.
-@compute @workgroup_size(64)
-fn reanchor(@builtin(global_invocation_id) gid: vec3u) {
-    let s = gid.x;
-    if s >= P.span_count {
-        return;
-    }
+// Formula (4), with the span form afresh every M = P.param pixels.
+fn reanchor(s: u32) {
     let every = max(P.param, 1u);
     let start = span_start(s);
     var w = start;
@@ -158,13 +161,8 @@ fn reanchor(@builtin(global_invocation_id) gid: vec3u) {
     }
 }
 
-// One thread per span: formula (4) with Kahan-compensated sums.
-@compute @workgroup_size(64)
-fn kahan(@builtin(global_invocation_id) gid: vec3u) {
-    let s = gid.x;
-    if s >= P.span_count {
-        return;
-    }
+// Formula (4) with Kahan-compensated sums.
+fn kahan(s: u32) {
     var sum = span_start(s);
     var comp = vec3f(0.0);
     for (var n = 0u; n < span_len(); n++) {
@@ -176,13 +174,8 @@ fn kahan(@builtin(global_invocation_id) gid: vec3u) {
     }
 }
 
-// One thread per span: formula (4) with a two-float accumulator (hi, lo) and increment (a, a_lo).
-@compute @workgroup_size(64)
-fn double_single(@builtin(global_invocation_id) gid: vec3u) {
-    let s = gid.x;
-    if s >= P.span_count {
-        return;
-    }
+// Formula (4) with a two-float accumulator (hi, lo) and increment (a, a_lo).
+fn double_single(s: u32) {
     var hi = span_start(s);
     var lo = vec3f(0.0);
     for (var n = 0u; n < span_len(); n++) {
@@ -196,13 +189,8 @@ fn double_single(@builtin(global_invocation_id) gid: vec3u) {
     }
 }
 
-// One thread per span: formula (4) in int32 16.16 fixed point (wrapping adds, as the numpy twin's int32 sums).
-@compute @workgroup_size(64)
-fn fixed16_16(@builtin(global_invocation_id) gid: vec3u) {
-    let s = gid.x;
-    if s >= P.span_count {
-        return;
-    }
+// Formula (4) in int32 16.16 fixed point (wrapping adds, as the numpy twin's int32 sums).
+fn fixed16_16(s: u32) {
     var w = spans[s].fixed_start.xyz;
     for (var n = 0u; n < span_len(); n++) {
         let f = vec3f(w);
