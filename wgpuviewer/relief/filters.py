@@ -26,7 +26,7 @@ DEFAULT_FILTER = "trilinear"
 DEFAULT_DERIVATIVES = "uv"
 
 #: A texel is hidden when the view ray towards it first meets the relief this much (layer depth) before it.
-VIS_TOLERANCE = 1e-3
+VIS_TOLERANCE = 1e-2
 #: Displaced and analytic derivatives longer than this many times the unperturbed ones are scaled down to it
 #: (and the pixel flagged): at depth discontinuities the traced uv jumps, and so would the footprint.
 DERIVATIVE_LIMIT = 8.0

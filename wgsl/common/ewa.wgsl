@@ -26,8 +26,14 @@ struct EwaLevel {
     area: f32,      // pi sqrt(F)
 }
 
+// Size of mip level `level`: max(1, floor(size / 2^level)), as WebGPU defines it. Computed, not queried:
+// textureDimensions with a level that differs between invocations returned level 0's size on lavapipe.
+fn level_size(tex: texture_2d<f32>, level: i32) -> vec2i {
+    return max(vec2i(textureDimensions(tex, 0)) >> vec2u(u32(level)), vec2i(1));
+}
+
 fn ewa_level(tex: texture_2d<f32>, fp: Footprint, level: i32) -> EwaLevel {
-    let size = vec2i(textureDimensions(tex, level));
+    let size = level_size(tex, level);
     let s = vec2f(size);
     let e = ellipse_coefficients(fp.dx * s, fp.dy * s);
     let a = e.a + 1.0;
@@ -93,36 +99,36 @@ fn ewa_average(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, visibility: boo
     (*acc).weight = 0.0;
     let j0 = i32(ceil(e.centre.y - e.half.y));
     let j1 = i32(floor(e.centre.y + e.half.y));
-    for (var j = j0; j <= j1 && j - j0 < i32(MAX_TEXELS_MAX); j++) {
+    var done = false;
+    for (var j = j0; j <= j1 && j - j0 < i32(MAX_TEXELS_MAX) && !done; j++) {
         let y = f32(j) - e.centre.y;
         let disc = e.b * e.b * y * y - 4.0 * e.a * (e.c * y * y - 1.0);
-        if disc <= 0.0 {
-            continue;
-        }
-        let root = sqrt(disc);
-        let i0 = i32(ceil(e.centre.x + (-e.b * y - root) / (2.0 * e.a)));
-        let i1 = i32(floor(e.centre.x + (-e.b * y + root) / (2.0 * e.a)));
-        var stop = i1 + 1;  // where the forward walk met a hidden texel (rows method)
-        for (var i = i0; i <= i1; i++) {
-            if ewa_full(acc) {
-                return ewa_result(tex, fp, e, acc);
-            }
-            if ewa_take(tex, fp, e, i, j, visibility, acc) && rows {
-                stop = i;
-                break;
-            }
-        }
-        if rows && stop <= i1 {
-            var back = i1;
-            for (; back > stop; back--) {
+        if disc > 0.0 {
+            let root = sqrt(disc);
+            let i0 = i32(ceil(e.centre.x + (-e.b * y - root) / (2.0 * e.a)));
+            let i1 = i32(floor(e.centre.x + (-e.b * y + root) / (2.0 * e.a)));
+            var stop = i1 + 1;  // where the forward walk met a hidden texel (rows method)
+            for (var i = i0; i <= i1 && !done; i++) {
                 if ewa_full(acc) {
-                    return ewa_result(tex, fp, e, acc);
-                }
-                if ewa_take(tex, fp, e, back, j, visibility, acc) {
+                    done = true;
+                } else if ewa_take(tex, fp, e, i, j, visibility, acc) && rows {
+                    stop = i;
                     break;
                 }
             }
-            filter_stats.hidden += u32(max(back - stop - 1, 0));  // dropped between the two hidden texels
+            if rows && stop <= i1 && !done {
+                var back = i1;
+                for (; back > stop && !done; back--) {
+                    if ewa_full(acc) {
+                        done = true;
+                    } else if ewa_take(tex, fp, e, back, j, visibility, acc) {
+                        break;
+                    }
+                }
+                if !done {
+                    filter_stats.hidden += u32(max(back - stop - 1, 0));  // dropped between the two hidden texels
+                }
+            }
         }
     }
     return ewa_result(tex, fp, e, acc);
