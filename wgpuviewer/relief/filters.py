@@ -90,7 +90,10 @@ class DerivativeSource:
 
 
 _LINEAR = ("linear", "linear", "linear")
-_ALPHA = Param("alpha", 2.0, 0.25, 8.0, float, "Gaussian sharpness: weight exp(-alpha r^2) - exp(-alpha), r in pixels")
+#: Gaussian sharpness. 6: the weights' variance is a one-pixel box's (1/12 pixel^2), the filter the supersampled
+#: reference applies; 2 (Heckbert, pbrt): sigma 1/2 pixel, smoother, more blur.
+_ALPHA = Param("alpha", 6.0, 1.6, 8.0, float, "Gaussian sharpness: weight exp(-alpha r^2) - exp(-alpha), r in "
+               "pixels (6: the variance of a one-pixel box; 2: sigma 1/2 pixel)")
 _MAX_TEXELS = Param("max_texels", 256, 4, 4096, int,
                     "texel cap per lookup: a larger footprint is read from a coarser level (flagged capped)")
 _VIS_TEXELS = Param("max_texels", 128, 4, 4096, int,
@@ -110,8 +113,9 @@ FILTERS: dict[str, Filter] = {
                "the probe pattern is the driver's).", "up to 8 x max_anisotropy texels (driver-defined)", _LINEAR,
                (Param("max_anisotropy", 16, 2, 16, int, "the sampler's max_anisotropy (WebGPU: 1 to 16)"),)),
         Filter("ewa", "Elliptical weighted average (Heckbert): Gaussian weights over the footprint ellipse from the "
-               "derivatives (plus a one-texel prefilter), read at the mip level of the minor axis and blended with "
-               "the next one; a texel cap.", "pi * major * minor / 4^level texels, at most max_texels", _LINEAR,
+               "derivatives (plus the bilinear tent's variance as prefilter), read where the minor axis spans 2-4 "
+               "texels, two levels blended; a texel cap.", "pi * major * minor / 4^level texels, at most max_texels",
+               _LINEAR,
                (_MAX_TEXELS, _ALPHA), texel_loop=True),
         Filter("ewa_approx", "EWA approximated by hardware trilinear probes along the major axis, Gaussian-weighted, "
                "at the minor axis' level (in the spirit of Mavridis & Papaioannou 2011).",

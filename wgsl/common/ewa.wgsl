@@ -1,11 +1,17 @@
 // Elliptical weighted average (Heckbert 1989) over a pixel's footprint, shared by ewa, ewa_vis and ewa_vis_rows;
 // the float64 twin is wgpuviewer/studies/filtering/cpu.py (tests compare them texel for texel).
 //
-// At mip level L (texel coordinates x = u * W_L - 0.5) the ellipse is the image of the unit pixel circle under
-// J_L = [dx dy] * size_L, widened by a one-texel prefilter (shape matrix J_L J_L^T + I, Heckbert's "+1" on A and
-// C): Q(U, V) = (A U^2 + B U V + C V^2) / F < 1 with F = A C - B^2 / 4 >= 1, so it always holds a texel centre.
-// Weight exp(-alpha Q) - exp(-alpha): a Gaussian of the pixel distance, zero on the ellipse.
-// Level: log2 of the minor semi-axis (level-0 texels), levels floor and floor + 1 blended by the fraction; when
+// At mip level L (texel coordinates x = u * W_L - 0.5) the footprint J_L = [dx dy] * size_L maps the pixel's
+// unit circle to the ellipse with shape matrix J_L J_L^T. Weights exp(-alpha Q) - exp(-alpha), Q = x^T S^-1 x,
+// a Gaussian of covariance S / (2 alpha), cut off at Q = 1. S = J_L J_L^T + (alpha / 3) I: the prefilter adds
+// the variance (1/6 texel^2 per axis) of the bilinear tent through which the reference sees the texels
+// (Heckbert adds 1, which blurs footprints of a few texels noticeably more), and keeps the ellipse at least
+// sqrt(alpha / 3) > sqrt(1/2) texel wide, so it always holds a texel centre. In coefficients:
+// Q(U, V) = (A U^2 + B U V + C V^2) / F with A = vx^2 + vy^2 + p, B = -2 (ux vx + uy vy), C = ux^2 + uy^2 + p,
+// p = alpha / 3, F = A C - B^2 / 4.
+// Level: log2 of the minor semi-axis (level-0 texels) minus 1, so the minor axis spans 2 to 4 texels of the level
+// read (at the minor axis' own level, as pbrt chooses it, the mip chain's box prefilter blurs footprints of a few
+// texels noticeably: measured in docs/filtering.md); levels floor and floor + 1 blended by the fraction; when
 // their texel estimate (area pi sqrt(F) + 2 (sqrt(A) + sqrt(C)) + 1 each) exceeds max_texels, the level rises
 // until it fits (flagged capped), and the loops stop after max_texels texels in any case.
 // Visibility: texel_hidden (visibility/*.wgsl, chosen by the composer) tests a texel centre. The full method
@@ -32,12 +38,17 @@ fn level_size(tex: texture_2d<f32>, level: i32) -> vec2i {
     return max(vec2i(textureDimensions(tex, 0)) >> vec2u(u32(level)), vec2i(1));
 }
 
+fn ewa_alpha() -> f32 {
+    return clamp(filter_params.alpha, ALPHA_MIN, ALPHA_MAX);
+}
+
 fn ewa_level(tex: texture_2d<f32>, fp: Footprint, level: i32) -> EwaLevel {
     let size = level_size(tex, level);
     let s = vec2f(size);
     let e = ellipse_coefficients(fp.dx * s, fp.dy * s);
-    let a = e.a + 1.0;
-    let c = e.c + 1.0;
+    let prefilter = ewa_alpha() / 3.0;
+    let a = e.a + prefilter;
+    let c = e.c + prefilter;
     let f = a * c - 0.25 * e.b * e.b;
     return EwaLevel(level, size, fp.uv * s - 0.5, a / f, e.b / f, c / f, vec2f(sqrt(c), sqrt(a)), 3.14159265 * sqrt(f));
 }
@@ -67,7 +78,7 @@ fn ewa_take(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, i: i32, j: i32, vi
         filter_stats.hidden += 1u;
         return true;
     }
-    let alpha = clamp(filter_params.alpha, ALPHA_MIN, ALPHA_MAX);
+    let alpha = ewa_alpha();
     let w = exp(-alpha * q) - exp(-alpha);
     (*acc).value += w * textureLoad(tex, wrap_texel(vec2i(i, j), e.size), e.level);
     (*acc).weight += w;
@@ -139,7 +150,7 @@ fn ewa(tex: texture_2d<f32>, footprint: Footprint, visibility: bool, rows: bool)
     let fp = loop_footprint(footprint, size0);
     let axes = footprint_axes(fp.dx * size0, fp.dy * size0);
     let top = i32(textureNumLevels(tex)) - 1;
-    let lod = clamp(log2(max(axes.minor, 1e-8)), 0.0, f32(top));
+    let lod = clamp(log2(max(axes.minor, 1e-8)) - 1.0, 0.0, f32(top));
     var level = i32(floor(lod));
     var frac = lod - f32(level);
     let budget = u32(clamp(filter_params.max_texels, MAX_TEXELS_MIN, MAX_TEXELS_MAX));

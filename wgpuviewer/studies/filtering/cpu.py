@@ -157,10 +157,10 @@ class _Level:
         return (np.array([i, j], np.float64) + 0.5) / self.size
 
 
-def _ewa_level(levels, uv, dx, dy, level: int) -> _Level:
+def _ewa_level(levels, uv, dx, dy, level: int, alpha: float) -> _Level:
     size = _size(levels[level])
     a0, b, c0, _ = ellipse_coefficients(dx * size, dy * size)
-    a, c = float(a0) + 1.0, float(c0) + 1.0
+    a, c = float(a0) + alpha / 3.0, float(c0) + alpha / 3.0
     f = a * c - 0.25 * float(b) ** 2
     return _Level(level, size, uv * size - 0.5, a / f, float(b) / f, c / f, np.sqrt([c, a]), np.pi * np.sqrt(f))
 
@@ -178,24 +178,24 @@ def ewa(levels, uv, dx, dy, *, max_texels: int = 256, alpha: float = 2.0, hidden
     dx, dy = _texture_bounded(dx, size0, flags), _texture_bounded(dy, size0, flags)
     _, minor, _ = footprint_axes(dx * size0, dy * size0)
     top = len(levels) - 1
-    lod = float(np.clip(np.log2(max(float(minor), 1e-8)), 0.0, top))
+    lod = float(np.clip(np.log2(max(float(minor), 1e-8)) - 1.0, 0.0, top))
     level = int(np.floor(lod))
     frac = lod - level
     for _ in range(32):
         if level >= top:
             break
-        estimate = _ewa_level(levels, uv, dx, dy, level).estimate
+        estimate = _ewa_level(levels, uv, dx, dy, level, alpha).estimate
         if frac > 0.0:
-            estimate += _ewa_level(levels, uv, dx, dy, level + 1).estimate
+            estimate += _ewa_level(levels, uv, dx, dy, level + 1, alpha).estimate
         if estimate <= max_texels:
             break
         level, frac = level + 1, 0.0
         flags[0] |= FLAGS["capped"]
     state = {"visited": 0, "texels": 0, "hidden": 0, "weights": {}}
-    value = _ewa_average(levels, uv, _ewa_level(levels, uv, dx, dy, level), max_texels, alpha, hidden, rows,
+    value = _ewa_average(levels, uv, _ewa_level(levels, uv, dx, dy, level, alpha), max_texels, alpha, hidden, rows,
                          state, flags)
     if frac > 0.0 and level < top:
-        other = _ewa_average(levels, uv, _ewa_level(levels, uv, dx, dy, level + 1), max_texels, alpha, hidden,
+        other = _ewa_average(levels, uv, _ewa_level(levels, uv, dx, dy, level + 1, alpha), max_texels, alpha, hidden,
                              rows, state, flags)
         value = value + frac * (other - value)
     return Filtered(value, state["texels"], state["hidden"], flags[0], state["weights"])
