@@ -1,4 +1,4 @@
-"""Command line: ``wgpuviewer view|render|techniques|info``."""
+"""Command line: ``wgpuviewer view|render|techniques|filters|info|accuracy|bench|filtering``."""
 
 from __future__ import annotations
 
@@ -37,6 +37,14 @@ def pick_technique(scene, name: str | None) -> str:
     return get_technique(name or scene.technique, "--technique").name
 
 
+def pick_filtering(args) -> dict:
+    """DrawConfig's filter and derivatives from ``--filter`` / ``--derivatives`` (checked against the registry)."""
+    from wgpuviewer.relief.filters import get_derivatives, get_filter
+
+    return {"filter": get_filter(args.filter, "--filter").name,
+            "derivatives": get_derivatives(args.derivatives, "--derivatives").name}
+
+
 def has_display() -> bool:
     if sys.platform.startswith("linux"):
         return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
@@ -54,8 +62,9 @@ def cmd_render(args) -> int:
     scene = load_scene_arg(args.scene)
     technique = pick_technique(scene, args.technique)
     size = parse_size(args.size) if args.size else DEFAULT_SIZE
+    filtering = pick_filtering(args)
     renderer = Renderer(scene, get_gpu(args.backend))
-    save_output(out, renderer.render(technique, size), args.mode)
+    save_output(out, renderer.render(renderer.config(technique, **filtering), size, mode=args.mode), args.mode)
     print(out)
     return 0
 
@@ -75,6 +84,7 @@ def cmd_view(args) -> int:
             and settings.last_technique in scene.techniques:
         technique_arg = settings.last_technique
     technique = pick_technique(scene, technique_arg)
+    filtering = pick_filtering(args)
     size = parse_size(args.size) if args.size else None
     if not window:
         from wgpuviewer.core.gpu import get_gpu
@@ -84,7 +94,7 @@ def cmd_view(args) -> int:
         out = Path("out") / f"{Path(scene.path).stem if scene.path else 'scene'}_{technique}.png"
         print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the scene to {out} instead")
         renderer = Renderer(scene, get_gpu(args.backend))
-        save_output(out, renderer.render(technique, size or DEFAULT_SIZE), "color")
+        save_output(out, renderer.render(renderer.config(technique, **filtering), size or DEFAULT_SIZE), "color")
         print(out)
         return 0
     from wgpuviewer.viewer.app import run_viewer
@@ -92,7 +102,7 @@ def cmd_view(args) -> int:
     keys = [k for k in args.keys.split(",") if k] if args.keys else []
     return run_viewer(
         scene, technique, backend=args.backend, frames=args.frames, screenshot=args.screenshot, keys=keys,
-        gui=args.gui, settings=settings, size=size,
+        gui=args.gui, settings=settings, size=size, **filtering,
     )
 
 
@@ -106,6 +116,59 @@ def cmd_techniques(args) -> int:
             kind = p.kind.__name__
             rng = "" if p.kind is bool else f" [{p.min:g}..{p.max:g}]"
             print(f"   - {p.name} ({kind}, default {p.default}{rng}): {p.doc}")
+    return 0
+
+
+def cmd_filters(args) -> int:
+    from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, DERIVATIVE_SOURCES, FILTERS
+
+    for f in FILTERS.values():
+        default = "  (default)" if f.name == DEFAULT_FILTER else ""
+        print(f"{f.name:<13} reads: {f.cost}{default}")
+        print(f"   {f.description}")
+        for p in f.params:
+            print(f"   - {p.name} ({p.kind.__name__}, default {p.default}, [{p.min:g}..{p.max:g}]): {p.doc}")
+    print("\nderivative sources (--derivatives):")
+    for d in DERIVATIVE_SOURCES.values():
+        default = "  (default)" if d.name == DEFAULT_DERIVATIVES else ""
+        print(f"{d.name:<13} {d.description}{default}")
+    return 0
+
+
+def _names(text, option):
+    if text is None:
+        return None
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    if not items:
+        raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
+    return items
+
+
+def _numbers(text, option, example):
+    items = _names(text, option)
+    if items is None:
+        return None
+    try:
+        return [float(x) for x in items]
+    except ValueError:
+        raise UserError(f"{option} {text!r}: expected comma-separated numbers, e.g. {example}") from None
+
+
+def cmd_filtering(args) -> int:
+    from wgpuviewer.studies.filtering.run import resolve_options, run
+
+    size = None
+    if args.size:
+        size = parse_size(args.size)
+    command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["filtering"] else "wgpuviewer filtering"
+    options = resolve_options(
+        args.suite, size=size, frames=args.frames, reliefs=_names(args.reliefs, "--reliefs"),
+        albedos=_names(args.albedos, "--albedos"), angles=_numbers(args.angles, "--angles", "0,45,80"),
+        footprints=_numbers(args.footprints, "--footprints", "1,4"), filters=_names(args.filters, "--filters"),
+        backend=args.backend, command=command,
+    )
+    run(options, Path(args.out), progress=not args.quiet)
+    print(Path(args.out) / "report.md")
     return 0
 
 
@@ -141,14 +204,7 @@ def cmd_accuracy(args) -> int:
 def cmd_bench(args) -> int:
     from wgpuviewer.bench.run import resolve_options, run
 
-    def names(text, option):
-        if text is None:
-            return None
-        items = [x.strip() for x in text.split(",") if x.strip()]
-        if not items:
-            raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
-        return items
-
+    names = _names
     angles = None
     if args.angles:
         try:
@@ -186,6 +242,32 @@ def cmd_info(args) -> int:
     return 0
 
 
+def add_filter_options(parser) -> None:
+    from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER
+
+    parser.add_argument("--filter", default=DEFAULT_FILTER,
+                        help=f"texture filter for the albedo and normal lookups (default {DEFAULT_FILTER}; "
+                        "`wgpuviewer filters` lists them)")
+    parser.add_argument("--derivatives", default=DEFAULT_DERIVATIVES,
+                        help=f"derivative source the filter's footprint comes from: uv, displaced, analytic "
+                        f"(default {DEFAULT_DERIVATIVES})")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or (argv[0] not in COMMANDS and argv[0] not in ("-h", "--help")):
+        argv = ["view", *argv]  # `wgpuviewer [SCENE] [--technique ...]` means view
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except UserError as error:
+        print(f"wgpuviewer: error: {error}", file=sys.stderr)
+        return error.exit_code
+    except KeyboardInterrupt:
+        return 130
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="wgpuviewer", description="Relief-mapping techniques on WebGPU: viewer, offscreen renderer, probe."
@@ -203,6 +285,7 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("--gui", choices=("glfw", "qt", "auto"), default="glfw",
                       help="window toolkit through rendercanvas (default glfw; qt needs PySide6/PyQt6)")
     view.add_argument("--size", help="window size WIDTHxHEIGHT in logical pixels (default: the saved size, 1280x720)")
+    add_filter_options(view)
     view.set_defaults(func=cmd_view)
 
     render = sub.add_parser("render", help="render a scene offscreen to PNG or .npy")
@@ -212,10 +295,14 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--size", help=f"WIDTHxHEIGHT (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
     render.add_argument("--mode", choices=OUTPUT_MODES, default="color", help="what to write")
     render.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    add_filter_options(render)
     render.set_defaults(func=cmd_render)
 
     techniques = sub.add_parser("techniques", help="list techniques, their keys, needed maps and parameters")
     techniques.set_defaults(func=cmd_techniques)
+
+    filters = sub.add_parser("filters", help="list texture filters, their parameters and the derivative sources")
+    filters.set_defaults(func=cmd_filters)
 
     accuracy = sub.add_parser("accuracy", help="probe each ray-search technique against the float64 reference")
     accuracy.add_argument("--heightmaps", nargs="+", default=["bricks", "bumps", "checker"], help="builtin maps")
@@ -240,25 +327,27 @@ def build_parser() -> argparse.ArgumentParser:
                        help="measure nothing: write report.md and plots from these results.csv files into --out")
     bench.set_defaults(func=cmd_bench)
 
+    filtering = sub.add_parser("filtering", help="texture filters on relief against a supersampled reference "
+                               "(results.csv, report.md, pareto.png, crops)")
+    filtering.add_argument("--out", required=True, help="output folder")
+    filtering.add_argument("--suite", choices=("smoke", "full"), default="full",
+                           help="full: every filter x derivative source on 150 cases (real GPUs); smoke: 3 cases, "
+                           "under 2 minutes on a software adapter")
+    filtering.add_argument("--size", help="frame WIDTHxHEIGHT (default: the suite's)")
+    filtering.add_argument("--frames", type=int, help="timed frames per configuration (median)")
+    filtering.add_argument("--reliefs", help="comma-separated: bricks, step, wall, flat0")
+    filtering.add_argument("--albedos", help="comma-separated: own, checker, stripes, photo")
+    filtering.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 86)")
+    filtering.add_argument("--footprints", help="comma-separated texels per pixel at the frame centre, e.g. 1,4")
+    filtering.add_argument("--filters", help="comma-separated filter names (trilinear, the baseline, always runs)")
+    filtering.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    filtering.add_argument("--quiet", action="store_true", help="no progress bar")
+    filtering.set_defaults(func=cmd_filtering)
+
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
     info.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     info.set_defaults(func=cmd_info)
     return parser
 
 
-COMMANDS = ("view", "render", "techniques", "accuracy", "bench", "info")
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    argv = list(sys.argv[1:] if argv is None else argv)
-    if not argv or (argv[0] not in COMMANDS and argv[0] not in ("-h", "--help")):
-        argv = ["view", *argv]  # `wgpuviewer [SCENE] [--technique ...]` means view
-    args = parser.parse_args(argv)
-    try:
-        return args.func(args)
-    except UserError as error:
-        print(f"wgpuviewer: error: {error}", file=sys.stderr)
-        return error.exit_code
-    except KeyboardInterrupt:
-        return 130
+COMMANDS = ("view", "render", "techniques", "filters", "accuracy", "bench", "filtering", "info")

@@ -96,10 +96,6 @@ _ALPHA = Param("alpha", 6.0, 1.6, 8.0, float, "Gaussian sharpness: weight exp(-a
                "pixels (6: the variance of a one-pixel box; 2: sigma 1/2 pixel)")
 _MAX_TEXELS = Param("max_texels", 256, 4, 4096, int,
                     "texel cap per lookup: a larger footprint is read from a coarser level (flagged capped)")
-_VIS_TEXELS = Param("max_texels", 128, 4, 4096, int,
-                    "texel cap per lookup (each texel costs a visibility trace); a larger footprint is read from "
-                    "a coarser level (flagged capped)")
-
 FILTERS: dict[str, Filter] = {
     f.name: f
     for f in (
@@ -124,11 +120,11 @@ FILTERS: dict[str, Filter] = {
         Filter("ewa_vis", "EWA that drops the footprint texels the relief hides (seed 003's full method): the view "
                "ray towards each texel's surface point is traced with the technique's own search; a texel whose ray "
                "meets the relief first gets no weight.", "EWA texels + one trace per texel", _LINEAR,
-               (_VIS_TEXELS, _ALPHA), texel_loop=True, visibility=True),
+               (_MAX_TEXELS, _ALPHA), texel_loop=True, visibility=True),
         Filter("ewa_vis_rows", "EWA with seed 003's cheap visibility: each row of the ellipse is walked from one end "
                "until a hidden texel, then from the other end back until a hidden texel; the texels between are "
                "dropped without being traced.", "EWA texels + one trace per texel walked", _LINEAR,
-               (_VIS_TEXELS, _ALPHA), texel_loop=True, visibility=True),
+               (_MAX_TEXELS, _ALPHA), texel_loop=True, visibility=True),
     )
 }
 

@@ -36,8 +36,9 @@ class TimingRun:
 
 
 def time_draws(renderer: Renderer, draws: list[DrawConfig], size: tuple[int, int],
-               frames: int, warmup: int, progress=None) -> TimingRun:
-    """Median GPU ms per frame of each of ``draws``, drawn round robin."""
+               frames: int, warmup: int, progress=None, mode: str = "color") -> TimingRun:
+    """Median GPU ms per frame of each of ``draws``, drawn round robin; ``mode`` as ``Renderer.encode``'s (e.g.
+    "albedo": the filtered albedo lookup alone, no shading)."""
     gpu = renderer.gpu
     device = gpu.device
     w, h = size
@@ -66,7 +67,7 @@ def time_draws(renderer: Renderer, draws: list[DrawConfig], size: tuple[int, int
         if timestamps and index is not None:
             writes = {"query_set": queries[i], "beginning_of_pass_write_index": 2 * index,
                       "end_of_pass_write_index": 2 * index + 1}
-        renderer.encode(encoder, [color_view], depth_view, (COLOR_FORMAT,), draws[i], camera, size,
+        renderer.encode(encoder, [color_view], depth_view, (COLOR_FORMAT,), draws[i], camera, size, mode,
                         timestamp_writes=writes)
         start = time.perf_counter()
         device.queue.submit([encoder.finish()])
