@@ -155,7 +155,8 @@ def _numbers(text, option, example):
 
 
 def cmd_filtering(args) -> int:
-    from wgpuviewer.studies.filtering.run import resolve_options, run
+    from wgpuviewer.studies.filtering.run import run
+    from wgpuviewer.studies.filtering.suites import resolve_options
 
     size = None
     if args.size:

@@ -16,7 +16,7 @@ import numpy as np
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import atomic_open, write_bytes
 
-from .run import BASELINE, COLUMNS, Config, Options, Suite
+from .suites import BASELINE, COLUMNS, Config, Options, Suite
 from .views import ALBEDOS, HEIGHT_SCALE, RELIEFS, TECHNIQUE, Case
 
 #: The crops' panels: the reference, then these configurations (label, Config), then their difference images.
