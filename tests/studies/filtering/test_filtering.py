@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 
 from wgpuviewer.cli import main
-from wgpuviewer.relief.filters import FILTERS
+from wgpuviewer.relief.filters import DERIVATIVE_LIMIT, FILTERS, FLAGS
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.studies.filtering import supersample as ss
 from wgpuviewer.studies.filtering.run import psnr
+from wgpuviewer.studies.filtering.suites import Config
 from wgpuviewer.studies.filtering.views import HEIGHT_SCALE, TEXTURE_SIZE, Case, depth_map, make_view
 
 SIZE = (32, 24)
@@ -102,6 +103,26 @@ def test_occlusion_mask_marks_pixels_straddling_hidden_texels(views):
     hits[:, 3:8, 0] += 3.0  # a jump between sub-columns 2 and 3 inside pixel 0 (n = 8); at 7 | 8 it crosses pixels
     mask = ss.occluded_pixels(hits, (1, 1), 8)
     assert mask.tolist() == [[True, False]]
+
+
+def test_displaced_derivatives_explode_at_depth_discontinuities_and_are_bounded(views):
+    """Where neighbouring pixels hit different surfaces the traced uv jumps: the raw displaced derivative is many
+    times the unperturbed one there; the source bounds it (flagged). On the flat relief it is the true, modest
+    stretch of the deeper plane and nothing is flagged; the analytic source does not jump at the edges."""
+    bounded = FLAGS["bounded"]
+    view, renderer = views(Case("bricks", "own", 80.0, 2.0))
+    stats = {source: renderer.render(Config("ewa", source).draw(), SIZE, view.camera, mode="albedo").filter
+             for source in ("displaced", "analytic")}
+    ratio = stats["displaced"][..., 3].view(np.float32)
+    flags = stats["displaced"][..., 2] >> 24
+    assert ratio.max() > 2 * DERIVATIVE_LIMIT and (flags & bounded).any()
+    assert ((flags & bounded) > 0)[ratio > DERIVATIVE_LIMIT * 1.01].all()
+    analytic = stats["analytic"][..., 3].view(np.float32)
+    assert np.median(analytic) < 2.0 and (analytic > DERIVATIVE_LIMIT).mean() < (ratio > DERIVATIVE_LIMIT).mean()
+    flat_view, flat = views(Case("flat0", "checker", 60.0, 2.0))
+    flat_stats = flat.render(Config("ewa", "displaced").draw(), SIZE, flat_view.camera, mode="albedo").filter
+    flat_ratio = flat_stats[..., 3].view(np.float32)
+    assert (flat_ratio > 1.0).all() and (flat_ratio < 1.5).all() and not ((flat_stats[..., 2] >> 24) & bounded).any()
 
 
 def test_gaussian_average_is_a_normalised_symmetric_kernel():
