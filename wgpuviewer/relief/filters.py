@@ -19,7 +19,7 @@ import numpy as np
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.wgsl import Generated
 
-from .techniques import Param
+from .techniques import Param, Parametrized, resolve_params
 
 #: The default filter and derivative source: hardware trilinear on the unperturbed uv (what the renderer always did).
 DEFAULT_FILTER = "trilinear"
@@ -45,7 +45,7 @@ FLAGS = {
 
 
 @dataclass(frozen=True)
-class Filter:
+class Filter(Parametrized):
     name: str
     description: str
     cost: str  # what it reads per lookup, for humans (`wgpuviewer filters`, the README)
@@ -61,15 +61,6 @@ class Filter:
     @property
     def wgsl_file(self) -> str:
         return f"filters/{self.name}.wgsl"
-
-    def param(self, name: str) -> Param:
-        for p in self.params:
-            if p.name == name:
-                return p
-        raise KeyError(name)
-
-    def defaults(self) -> dict:
-        return {p.name: p.kind(p.default) for p in self.params}
 
     @property
     def uniform_fields(self) -> tuple[str, ...]:
@@ -158,16 +149,7 @@ def get_derivatives(name: str, where: str = "derivatives") -> DerivativeSource:
 
 def resolve_filter_params(f: Filter, overrides: dict | None = None, where: str = "") -> dict:
     """Defaults merged with checked overrides (unknown names are errors naming ``where``)."""
-    values = f.defaults()
-    for name, value in (overrides or {}).items():
-        key = f"{where}{name}" if where else f"{f.name}.{name}"
-        try:
-            param = f.param(name)
-        except KeyError:
-            known = ", ".join(p.name for p in f.params) or "none"
-            raise UserError(f"{key}: unknown parameter of filter {f.name!r}; known: {known}") from None
-        values[name] = param.validate(value, key)
-    return values
+    return resolve_params(f, overrides, where, "filter")
 
 
 def _f32(x: float) -> str:
