@@ -94,10 +94,11 @@ def test_reference_converges(views, case, tolerance):
 
 def test_occlusion_mask_marks_pixels_straddling_hidden_texels(views):
     bricks_view, bricks = views(Case("bricks", "own", 80.0, 2.0))
-    flat_view, flat = views(Case("flat0", "checker", 60.0, 2.0))
     occluded = ss.supersample(bricks, bricks_view, 8).occluded
     assert 0.05 < occluded.mean() < 0.9
-    assert not ss.supersample(flat, flat_view, 8).occluded.any()
+    for angle in (60.0, 85.0):  # at 85 degrees the rays along the view are ~10 times farther apart than across
+        flat_view, flat = views(Case("flat0", "checker", angle, 2.0))
+        assert not ss.supersample(flat, flat_view, 8).occluded.any(), angle
     # a pair of neighbouring rays 3 texels apart inside one pixel, all other neighbours 0.1 apart: that pixel only
     hits = (np.indices((8, 16)).transpose(1, 2, 0)[..., ::-1] * 0.1).astype(np.float32)  # (x, y) * 0.1 texel
     hits[:, 3:8, 0] += 3.0  # a jump between sub-columns 2 and 3 inside pixel 0 (n = 8); at 7 | 8 it crosses pixels

@@ -18,6 +18,7 @@ an occluding edge, so the texels between their hits are seen by no ray of the pi
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -88,23 +89,28 @@ def gaussian_average(values: np.ndarray, covered: np.ndarray, n: int, alpha: flo
 
 
 def occluded_pixels(hits: np.ndarray, texels: tuple[int, int], n: int) -> np.ndarray:
-    """(H, W) bool: pixels with a neighbouring sub-pixel pair whose hits jump across hidden texels."""
-    scale = np.asarray(texels, np.float64)
-    uv = hits.astype(np.float64) * scale
+    """(H, W) bool: pixels with a neighbouring sub-pixel pair whose hits jump across hidden texels: farther apart
+    than JUMP_TEXELS and than JUMP_FACTOR times the pixel's median spacing in the same direction (at grazing views
+    the rays along the view are many times farther apart than across it, on any relief)."""
+    uv = hits.astype(np.float64) * np.asarray(texels, np.float64)
     hn, wn = uv.shape[:2]
-    jumps = np.zeros((hn, wn))
-    across = np.linalg.norm(np.diff(uv, axis=1), axis=-1)  # (hn, wn - 1)
-    down = np.linalg.norm(np.diff(uv, axis=0), axis=-1)  # (hn - 1, wn)
-    # Pairs inside one pixel only: the last column/row of each block has no partner in it.
-    across[:, n - 1::n] = 0.0
-    down[n - 1::n, :] = 0.0
-    jumps[:, :-1] = np.maximum(jumps[:, :-1], np.nan_to_num(across))
-    jumps[:-1, :] = np.maximum(jumps[:-1, :], np.nan_to_num(down))
-    spacing = np.concatenate([np.nan_to_num(across[:, :, None]), np.zeros((hn, 1, 1))], axis=1)[..., 0]
     h, w = hn // n, wn // n
-    blocks_max = jumps.reshape(h, n, w, n).max(axis=(1, 3))
-    blocks_median = np.median(spacing.reshape(h, n, w, n).transpose(0, 2, 1, 3).reshape(h, w, -1), axis=-1)
-    return (blocks_max > JUMP_TEXELS) & (blocks_max > JUMP_FACTOR * np.maximum(blocks_median, 1e-6))
+    occluded = np.zeros((h, w), bool)
+    for axis in (1, 0):
+        gaps = np.full((hn, wn), np.nan)
+        step = np.linalg.norm(np.diff(uv, axis=axis), axis=-1)
+        if axis == 1:
+            gaps[:, :-1] = step
+            gaps[:, n - 1::n] = np.nan  # pairs inside one pixel only
+        else:
+            gaps[:-1, :] = step
+            gaps[n - 1::n, :] = np.nan
+        blocks = gaps.reshape(h, n, w, n).transpose(0, 2, 1, 3).reshape(h, w, n * n)
+        with np.errstate(invalid="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # blocks of uncovered rays are all NaN
+            largest, median = np.nanmax(blocks, axis=-1), np.nanmedian(blocks, axis=-1)
+        occluded |= (largest > JUMP_TEXELS) & (largest > JUMP_FACTOR * np.maximum(median, 1e-6))
+    return occluded
 
 
 def supersample(renderer: Renderer, view: View, n: int) -> Supersample:
