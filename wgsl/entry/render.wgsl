@@ -6,7 +6,8 @@
 // #include "common/heat.wgsl"
 // #include "common/footprint.wgsl"
 
-// Frame.mode values of fs_color (the window); offscreen rendering reads fs_data's raw target instead.
+// Frame.mode values of fs_color (the window); offscreen rendering reads fs_data's raw targets instead, whose colour
+// follows MODE_ALBEDO too.
 const MODE_COLOR: u32 = 0u;
 const MODE_COST: u32 = 1u;
 const MODE_UV: u32 = 2u;
