@@ -1,4 +1,4 @@
-"""Command line: ``wgpuviewer view|render|techniques|info``."""
+"""Command line: ``wgpuviewer view|render|techniques|filters|info|accuracy|bench|filtering``."""
 
 from __future__ import annotations
 
@@ -39,14 +39,24 @@ def pick_technique(scene, name: str | None) -> str:
     return get_technique(name or scene.technique, "--technique").name
 
 
+def pick_filtering(args) -> dict:
+    """DrawConfig's filter and derivatives from ``--filter`` / ``--derivatives`` (checked against the registry)."""
+    from wgpuviewer.relief.filters import get_derivatives, get_filter
+
+    return {"filter": get_filter(args.filter, "--filter").name,
+            "derivatives": get_derivatives(args.derivatives, "--derivatives").name}
+
+
 def has_display() -> bool:
     if sys.platform.startswith("linux"):
         return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
     return True
 
 
-def render_to(out: Path, scene, technique: str, size: tuple[int, int], mode: str, backend: str | None) -> None:
-    """Render ``scene`` offscreen into ``out`` (.png or .npy), the maps it needs built first with a progress bar."""
+def render_to(out: Path, scene, technique: str, size: tuple[int, int], mode: str, backend: str | None,
+              filtering: dict) -> None:
+    """Render ``scene`` offscreen into ``out`` (.png or .npy), the maps it needs built first with a progress bar;
+    ``filtering``: the texture filter and derivative source (``pick_filtering``)."""
     from wgpuviewer.core.gpu import get_gpu
     from wgpuviewer.relief.output import save_output
     from wgpuviewer.relief.renderer import Renderer
@@ -54,7 +64,7 @@ def render_to(out: Path, scene, technique: str, size: tuple[int, int], mode: str
     renderer = Renderer(scene, get_gpu(backend))
     with terminal_progress(f"maps for {technique}") as progress:
         renderer.prepare(technique, progress)
-    save_output(out, renderer.render(technique, size), mode)
+    save_output(out, renderer.render(renderer.config(technique, **filtering), size, mode=mode), mode)
 
 
 def cmd_render(args) -> int:
@@ -66,7 +76,8 @@ def cmd_render(args) -> int:
         raise UserError(f"-o {out}: unknown output type {out.suffix!r}; use .png (image) or .npy (raw float32 data)")
     scene = scene_from_args(args)
     technique = pick_technique(scene, args.technique)
-    render_to(out, scene, technique, parse_size(args.size) if args.size else DEFAULT_SIZE, args.mode, args.backend)
+    size = parse_size(args.size) if args.size else DEFAULT_SIZE
+    render_to(out, scene, technique, size, args.mode, args.backend, pick_filtering(args))
     print(out)
     return 0
 
@@ -102,11 +113,12 @@ def cmd_view(args) -> int:
     if last and technique_arg is None and settings.last_technique in scene.techniques:
         technique_arg = settings.last_technique
     technique = pick_technique(scene, technique_arg)
+    filtering = pick_filtering(args)
     size = parse_size(args.size) if args.size else None
     if not window:
         out = Path("out") / f"{Path(scene.path).stem if scene.path else 'scene'}_{technique}.png"
         print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the scene to {out} instead")
-        render_to(out, scene, technique, size or DEFAULT_SIZE, "color", args.backend)
+        render_to(out, scene, technique, size or DEFAULT_SIZE, "color", args.backend, filtering)
         print(out)
         return 0
     from wgpuviewer.viewer.app import run_viewer
@@ -114,7 +126,7 @@ def cmd_view(args) -> int:
     keys = [k for k in args.keys.split(",") if k] if args.keys else []
     return run_viewer(
         scene, technique, backend=args.backend, frames=args.frames, screenshot=args.screenshot, keys=keys,
-        gui=args.gui, settings=settings, size=size,
+        gui=args.gui, settings=settings, size=size, **filtering,
     )
 
 
@@ -128,6 +140,60 @@ def cmd_techniques(args) -> int:
             kind = p.kind.__name__
             rng = "" if p.kind is bool else f" [{p.min:g}..{p.max:g}]"
             print(f"   - {p.name} ({kind}, default {p.default}{rng}): {p.doc}")
+    return 0
+
+
+def cmd_filters(args) -> int:
+    from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, DERIVATIVE_SOURCES, FILTERS
+
+    for f in FILTERS.values():
+        default = "  (default)" if f.name == DEFAULT_FILTER else ""
+        print(f"{f.name:<13} reads: {f.cost}{default}")
+        print(f"   {f.description}")
+        for p in f.params:
+            print(f"   - {p.name} ({p.kind.__name__}, default {p.default}, [{p.min:g}..{p.max:g}]): {p.doc}")
+    print("\nderivative sources (--derivatives):")
+    for d in DERIVATIVE_SOURCES.values():
+        default = "  (default)" if d.name == DEFAULT_DERIVATIVES else ""
+        print(f"{d.name:<13} {d.description}{default}")
+    return 0
+
+
+def _names(text, option):
+    if text is None:
+        return None
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    if not items:
+        raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
+    return items
+
+
+def _numbers(text, option, example):
+    items = _names(text, option)
+    if items is None:
+        return None
+    try:
+        return [float(x) for x in items]
+    except ValueError:
+        raise UserError(f"{option} {text!r}: expected comma-separated numbers, e.g. {example}") from None
+
+
+def cmd_filtering(args) -> int:
+    from wgpuviewer.studies.filtering.run import run
+    from wgpuviewer.studies.filtering.suites import resolve_options
+
+    size = None
+    if args.size:
+        size = parse_size(args.size)
+    command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["filtering"] else "wgpuviewer filtering"
+    options = resolve_options(
+        args.suite, size=size, frames=args.frames, reliefs=_names(args.reliefs, "--reliefs"),
+        albedos=_names(args.albedos, "--albedos"), angles=_numbers(args.angles, "--angles", "0,45,80"),
+        footprints=_numbers(args.footprints, "--footprints", "1,4"), filters=_names(args.filters, "--filters"),
+        backend=args.backend, command=command,
+    )
+    run(options, Path(args.out), progress=not args.quiet)
+    print(Path(args.out) / "report.md")
     return 0
 
 
@@ -163,14 +229,7 @@ def cmd_accuracy(args) -> int:
 def cmd_bench(args) -> int:
     from wgpuviewer.bench.run import resolve_options, run
 
-    def names(text, option):
-        if text is None:
-            return None
-        items = [x.strip() for x in text.split(",") if x.strip()]
-        if not items:
-            raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
-        return items
-
+    names = _names
     angles = None
     if args.angles:
         try:
@@ -221,6 +280,19 @@ def cmd_info(args) -> int:
     return 0
 
 
+def add_filter_options(parser) -> None:
+    from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER
+
+    parser.add_argument("--filter", default=DEFAULT_FILTER,
+                        help=f"texture filter for the albedo and normal lookups (default {DEFAULT_FILTER}; "
+                        "`wgpuviewer filters` lists them)")
+    parser.add_argument("--derivatives", default=DEFAULT_DERIVATIVES,
+                        help=f"derivative source the filter's footprint comes from: uv, displaced, analytic "
+                        f"(default {DEFAULT_DERIVATIVES})")
+
+
+
+
 def build_parser() -> argparse.ArgumentParser:
     from wgpuviewer.core.gpu import BACKEND_CHOICES, BACKEND_ENV
     from wgpuviewer.relief.output import OUTPUT_MODES
@@ -242,6 +314,7 @@ def build_parser() -> argparse.ArgumentParser:
                       help="window toolkit through rendercanvas (default glfw; qt needs PySide6/PyQt6)")
     view.add_argument("--size", help="window size WIDTHxHEIGHT in logical pixels (default: the saved size, 1280x720)")
     view.add_argument("--material", metavar="DIR", help=MATERIAL_HELP)
+    add_filter_options(view)
     view.set_defaults(func=cmd_view)
 
     render = sub.add_parser("render", help="render a scene offscreen to PNG or .npy")
@@ -252,10 +325,14 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--mode", choices=OUTPUT_MODES, default="color", help="what to write")
     render.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     render.add_argument("--material", metavar="DIR", help=MATERIAL_HELP)
+    add_filter_options(render)
     render.set_defaults(func=cmd_render)
 
     techniques = sub.add_parser("techniques", help="list techniques, their keys, needed maps and parameters")
     techniques.set_defaults(func=cmd_techniques)
+
+    filters = sub.add_parser("filters", help="list texture filters, their parameters and the derivative sources")
+    filters.set_defaults(func=cmd_filters)
 
     accuracy = sub.add_parser("accuracy", help="probe each ray-search technique against the float64 reference")
     accuracy.add_argument("--heightmaps", nargs="+", default=["bricks", "bumps", "checker"], help="builtin maps")
@@ -290,13 +367,30 @@ def build_parser() -> argparse.ArgumentParser:
     perspective.add_argument("--quiet", action="store_true", help="no progress bar")
     perspective.set_defaults(func=cmd_perspective)
 
+    filtering = sub.add_parser("filtering", help="texture filters on relief against a supersampled reference "
+                               "(results.csv, report.md, pareto.png, crops)")
+    filtering.add_argument("--out", required=True, help="output folder")
+    filtering.add_argument("--suite", choices=("smoke", "full"), default="full",
+                           help="full: every filter x derivative source on 150 cases (real GPUs); smoke: 3 cases, "
+                           "under 2 minutes on a software adapter")
+    filtering.add_argument("--size", help="frame WIDTHxHEIGHT (default: the suite's)")
+    filtering.add_argument("--frames", type=int, help="timed frames per configuration (median)")
+    filtering.add_argument("--reliefs", help="comma-separated: bricks, step, wall, flat0")
+    filtering.add_argument("--albedos", help="comma-separated: own, checker, stripes, photo")
+    filtering.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 86)")
+    filtering.add_argument("--footprints", help="comma-separated texels per pixel at the frame centre, e.g. 1,4")
+    filtering.add_argument("--filters", help="comma-separated filter names (trilinear, the baseline, always runs)")
+    filtering.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    filtering.add_argument("--quiet", action="store_true", help="no progress bar")
+    filtering.set_defaults(func=cmd_filtering)
+
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
     info.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     info.set_defaults(func=cmd_info)
     return parser
 
 
-COMMANDS = ("view", "render", "techniques", "accuracy", "bench", "perspective", "info")
+COMMANDS = ("view", "render", "techniques", "filters", "accuracy", "bench", "filtering", "perspective", "info")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -76,9 +76,9 @@ def test_probe_structs_match_the_probe():
 
 def test_data_out_matches_the_offscreen_targets():
     fields = struct_fields(read_wgsl("entry/render.wgsl"), "DataOut")
-    assert [t for _, t in fields] == ["vec4f", "vec4u", "u32"]
-    assert (renderer.COLOR_FORMAT, renderer.DATA_FORMAT, renderer.LAYERS_FORMAT) == (
-        "rgba8unorm-srgb", "rgba32uint", "r32uint")  # 4 floats, 4 x 32-bit uints, 1 x 32-bit uint
+    assert [t for _, t in fields] == ["vec4f", "vec4u", "u32", "vec4u"]
+    assert renderer.OFFSCREEN_FORMATS == (
+        "rgba8unorm-srgb", "rgba32uint", "r32uint", "rgba32uint")  # 4 floats, 4 x u32, 1 x u32, 4 x u32
 
 
 def test_generated_interface_follows_the_registry():

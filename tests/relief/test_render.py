@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from wgpuviewer.relief.output import mode_data, mode_picture
-from wgpuviewer.relief.renderer import Renderer
+from wgpuviewer.relief.renderer import OFFSCREEN_FORMATS, Renderer
 from wgpuviewer.relief.techniques import TECHNIQUES
 from wgpuviewer.scene import default_scene_path, load_scene
 
@@ -22,6 +22,7 @@ GOLDEN_SIZE = (192, 108)
 GOLDEN_ADAPTER = GOLDEN / "adapter.txt"
 MAX_MEAN_DIFF = 0.5  # mean absolute difference, 8-bit levels
 MAX_BAD_FRACTION = 0.002  # fraction of pixels more than 16 levels off
+OFFSCREEN = "+".join(OFFSCREEN_FORMATS)  # the targets in a pipeline's name
 
 
 def adapter_family(summary: str) -> str:
@@ -107,7 +108,7 @@ def test_only_what_the_scene_needs(gpu):
     assert renderer.created == []  # nothing before the first frame
     renderer.render("normal", (64, 64))
     assert not [c for c in renderer.created if c.endswith(".depth")]
-    assert [c for c in renderer.created if c.startswith("pipeline:")] == ["pipeline:normal:rgba8unorm-srgb+rgba32uint+r32uint"]
+    assert [c for c in renderer.created if c.startswith("pipeline:")] == [f"pipeline:normal:{OFFSCREEN}"]
     textures = sorted(c for c in renderer.created if c.startswith("texture:"))
     assert textures == ["texture:bricks.albedo", "texture:bricks.normal"]
 
@@ -123,7 +124,7 @@ def test_resources_follow_the_selected_technique(gpu):
     renderer.render("steep", (32, 32))
     assert renderer.created[: len(before)] == before
     new = renderer.created[len(before) :]
-    assert new == ["pipeline:steep:rgba8unorm-srgb+rgba32uint+r32uint"]  # steep reuses every texture
+    assert new == [f"pipeline:steep:{OFFSCREEN}"]  # steep reuses every texture
 
 
 def test_grazing_camera_renders_finite(gpu):

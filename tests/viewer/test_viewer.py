@@ -113,6 +113,16 @@ def test_split_view_shows_two_techniques(runs):
     assert np.abs(split[:, right] - basic[:, right]).mean() > 1.0
 
 
+def test_filter_key_changes_the_active_half_only(runs):
+    """F cycles the active half's texture filter, Shift+F its derivative source: B = pom with EWA on the displaced
+    uv (trilinear -> aniso -> ewa), A stays pom with trilinear."""
+    pom = runs("pom", "H,5").image
+    split = runs("filters", "H,5,B,Tab,5,f,f,F")
+    left, right = slice(0, 150), slice(170, 320)
+    assert np.abs(split.image[:, left] - pom[:, left]).mean() < 0.5
+    assert np.abs(split.image[:, right] - pom[:, right]).mean() > 0.3
+
+
 def test_interactive_session_saves_its_settings(display, adapter, tmp_path):
     code = (
         "import sys; from wgpuviewer.viewer.app import run_viewer; from wgpuviewer.scene import *;"

@@ -12,18 +12,19 @@ from wgpuviewer.core.io import atomic_open
 
 from .renderer import OffscreenImage
 
-OUTPUT_MODES = ("color", "uv", "depth", "cost", "layers")
+OUTPUT_MODES = ("color", "uv", "depth", "cost", "layers", "albedo")
 OUTPUT_SUFFIXES = (".png", ".npy")
 
 
 def mode_data(image: OffscreenImage, mode: str) -> np.ndarray:
     """Raw float32 data of a mode; NaN where nothing was drawn (except colour, which shows the background).
 
-    color: (H, W, 3) the sRGB image in [0, 1]; uv: (H, W, 2) hit UV (not wrapped);
+    color: (H, W, 3) the sRGB image in [0, 1] (albedo: the same of an image rendered with mode "albedo", the
+    filtered albedo unlit); uv: (H, W, 2) hit UV (not wrapped);
     depth: (H, W) hit layer depth t; cost: (H, W) depth fetches per pixel; layers: (H, W) depth layers the
     search used (pom_adaptive's N; 0 for techniques without layers).
     """
-    if mode == "color":
+    if mode in ("color", "albedo"):
         return image.color[:, :, :3].astype(np.float32) / 255.0
     covered = image.covered
     d = image.data
@@ -42,7 +43,7 @@ def mode_data(image: OffscreenImage, mode: str) -> np.ndarray:
 
 def mode_picture(image: OffscreenImage, mode: str) -> np.ndarray:
     """(H, W, 3) uint8 RGB picture of a mode."""
-    if mode == "color":
+    if mode in ("color", "albedo"):
         return image.color[:, :, :3].copy()
     data = mode_data(image, mode)
     covered = image.covered

@@ -50,6 +50,16 @@ def _derived(technique) -> list[str]:
     return [n for n in technique.textures if MAP_SLOTS[n].derived]
 
 
+def material_layout_entries(technique, textures: tuple[str, ...] = ()) -> list[dict]:
+    """Group 1 of a probe: the technique's uniform, the sampler, its derived maps and ``textures`` slots."""
+    C = wgpu.ShaderStage.COMPUTE
+    return [
+        {"binding": PARAMS_BINDING, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.uniform}},
+        {"binding": SAMPLER_BINDING, "visibility": C, "sampler": {"type": wgpu.SamplerBindingType.filtering}},
+        *layout_entries([*textures, *_derived(technique)], C),
+    ]
+
+
 def _pipeline(gpu: Gpu, technique_name: str) -> tuple[wgpu.GPUComputePipeline, list]:
     cache = gpu.cache.setdefault("probe_pipelines", {})
     if technique_name not in cache:
@@ -58,21 +68,8 @@ def _pipeline(gpu: Gpu, technique_name: str) -> tuple[wgpu.GPUComputePipeline, l
         module = device.create_shader_module(label=f"probe:{technique.name}",
                                              code=compose_technique(technique, "probe").code)
         C = wgpu.ShaderStage.COMPUTE
-        io_layout = device.create_bind_group_layout(
-            label="probe:io",
-            entries=[
-                {"binding": 0, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.read_only_storage}},
-                {"binding": 1, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.storage}},
-            ],
-        )
-        material_layout = device.create_bind_group_layout(
-            label="probe:material",
-            entries=[
-                {"binding": PARAMS_BINDING, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.uniform}},
-                {"binding": SAMPLER_BINDING, "visibility": C, "sampler": {"type": wgpu.SamplerBindingType.filtering}},
-                *layout_entries(_derived(technique), C),
-            ],
-        )
+        io_layout = device.create_bind_group_layout(label="probe:io", entries=io_layout_entries(C))
+        material_layout = device.create_bind_group_layout(label="probe:material", entries=material_layout_entries(technique))
         layout = device.create_pipeline_layout(label="probe", bind_group_layouts=[io_layout, material_layout])
         pipeline = device.create_compute_pipeline(
             label=f"probe:{technique.name}", layout=layout, compute={"module": module, "entry_point": "probe_main"}
@@ -169,45 +166,68 @@ def _trace(tech, values: dict, height: np.ndarray, uv: np.ndarray, view: np.ndar
     S = wgpu.BufferUsage
     ray_buf = device.create_buffer_with_data(label="probe:rays", data=rays, usage=S.STORAGE)
     hit_buf = device.create_buffer(label="probe:hits", size=n * HIT_STRIDE, usage=S.STORAGE | S.COPY_SRC)
-    params_buf = device.create_buffer_with_data(
-        label="probe:params", data=pack_trace_params(tech, height_scale, height.shape, values), usage=S.UNIFORM
-    )
-    depth = 1.0 - height
-    maps = [(name, MAP_SLOTS[name].build(gpu, depth, height_scale, f"probe:{name}",
-                                         *((probe,) if MAP_SLOTS[name].measured else ())))
-            for name in _derived(tech)]
-    mode = wgpu.AddressMode.repeat if address == "repeat" else wgpu.AddressMode.clamp_to_edge
-    sampler = device.create_sampler(
-        label="probe:sampler", address_mode_u=mode, address_mode_v=mode, mag_filter="linear", min_filter="linear"
-    )
-    io_group = device.create_bind_group(
-        layout=io_layout,
-        entries=[
-            {"binding": 0, "resource": {"buffer": ray_buf}},
-            {"binding": 1, "resource": {"buffer": hit_buf}},
-        ],
-    )
-    material_group = device.create_bind_group(
-        layout=material_layout,
-        entries=[
-            {"binding": PARAMS_BINDING, "resource": {"buffer": params_buf}},
-            {"binding": SAMPLER_BINDING, "resource": sampler},
-            *({"binding": binding(name), "resource": texture.create_view()} for name, texture in maps),
-        ],
-    )
-    groups = -(-n // _WORKGROUP)
-    encoder = device.create_command_encoder(label="probe")
-    pass_ = encoder.begin_compute_pass(label="probe")
-    pass_.set_pipeline(pipeline)
-    pass_.set_bind_group(0, io_group)
-    pass_.set_bind_group(1, material_group)
-    # Large ray sets: a 2D grid of workgroups; the shader folds it back into one index.
-    pass_.dispatch_workgroups(min(groups, _MAX_GROUPS), -(-groups // _MAX_GROUPS), 1)
-    pass_.end()
-    device.queue.submit([encoder.finish()])
-    raw = np.frombuffer(device.queue.read_buffer(hit_buf), np.uint8).reshape(n, HIT_STRIDE)
+    material_group = material_bind_group(gpu, material_layout, tech, height, height_scale, values, address)
+    raw = dispatch(gpu, pipeline, [io_bind_group(gpu, io_layout, ray_buf, hit_buf), material_group], n, hit_buf,
+                   HIT_STRIDE)
     f32 = raw.view(np.float32)
     u32 = raw.view(np.uint32)
     return ProbeResult(uv=f32[:, 0:2].astype(np.float64), depth=f32[:, 2].copy(), fetches=u32[:, 3].copy(),
                        capped=u32[:, 4] != 0, layers=u32[:, 5].copy())
 
+
+def io_layout_entries(visibility) -> list[dict]:
+    """Group 0 of a probe: its inputs (read-only storage) and outputs (storage)."""
+    return [
+        {"binding": 0, "visibility": visibility, "buffer": {"type": wgpu.BufferBindingType.read_only_storage}},
+        {"binding": 1, "visibility": visibility, "buffer": {"type": wgpu.BufferBindingType.storage}},
+    ]
+
+
+def io_bind_group(gpu: Gpu, layout, inputs: wgpu.GPUBuffer, outputs: wgpu.GPUBuffer) -> wgpu.GPUBindGroup:
+    return gpu.device.create_bind_group(layout=layout, entries=[
+        {"binding": 0, "resource": {"buffer": inputs}}, {"binding": 1, "resource": {"buffer": outputs}}])
+
+
+def material_bind_group(gpu: Gpu, layout, tech, height: np.ndarray, height_scale: float, values: dict,
+                        address: str, extra: tuple = ()) -> wgpu.GPUBindGroup:
+    """Group 1 of a probe: the technique's uniform, a linear sampler with ``address``, its height-derived maps
+    built from ``height`` as the renderer builds them, and ``extra`` (binding, texture) pairs."""
+    device = gpu.device
+    params_buf = device.create_buffer_with_data(
+        label="probe:params", data=pack_trace_params(tech, height_scale, height.shape, values),
+        usage=wgpu.BufferUsage.UNIFORM,
+    )
+    depth = 1.0 - height
+    maps = [(binding(n), MAP_SLOTS[n].build(gpu, depth, height_scale, f"probe:{n}",
+                                            *((probe,) if MAP_SLOTS[n].measured else ())))
+            for n in _derived(tech)]
+    mode = wgpu.AddressMode.repeat if address == "repeat" else wgpu.AddressMode.clamp_to_edge
+    sampler = device.create_sampler(
+        label="probe:sampler", address_mode_u=mode, address_mode_v=mode, mag_filter="linear", min_filter="linear"
+    )
+    return device.create_bind_group(
+        layout=layout,
+        entries=[
+            {"binding": PARAMS_BINDING, "resource": {"buffer": params_buf}},
+            {"binding": SAMPLER_BINDING, "resource": sampler},
+            *({"binding": b, "resource": texture.create_view()} for b, texture in [*maps, *extra]),
+        ],
+    )
+
+
+def dispatch(gpu: Gpu, pipeline, groups: list, n: int, out: wgpu.GPUBuffer, stride: int) -> np.ndarray:
+    """Run a probe kernel over ``n`` items with bind groups ``groups`` (index = group; None: skip) and read
+    ``out`` back as (n, stride) bytes."""
+    device = gpu.device
+    count = -(-n // _WORKGROUP)
+    encoder = device.create_command_encoder(label="probe")
+    pass_ = encoder.begin_compute_pass(label="probe")
+    pass_.set_pipeline(pipeline)
+    for index, group in enumerate(groups):
+        if group is not None:
+            pass_.set_bind_group(index, group)
+    # Large sets: a 2D grid of workgroups; the shader folds it back into one index.
+    pass_.dispatch_workgroups(min(count, _MAX_GROUPS), -(-count // _MAX_GROUPS), 1)
+    pass_.end()
+    device.queue.submit([encoder.finish()])
+    return np.frombuffer(device.queue.read_buffer(out), np.uint8).reshape(n, stride)

@@ -1,10 +1,12 @@
 """Drawing a scene with one technique, into a window surface or offscreen.
 
-What to draw comes per draw as a frozen ``DrawConfig`` (technique, its parameters, a height-scale override);
-the renderer holds no per-technique state of its own beyond caches. Everything is built lazily from what the
-drawn technique needs ("model only what a scene needs"): a material's depth texture exists only once a technique
-that traces depth is drawn, pipelines are compiled on first use and cached. ``Renderer.created`` logs each GPU
-resource it builds, so tests (and curious users) can see exactly what a scene cost.
+What to draw comes per draw as a frozen ``DrawConfig`` (technique, its parameters, a height-scale override, the
+texture filter with its parameters and the derivative source it is given); the renderer holds no per-technique
+state of its own beyond caches. Everything is built lazily from what the drawn technique needs ("model only what
+a scene needs"): a material's depth texture exists only once a technique that traces depth is drawn, pipelines are
+compiled on first use and cached per technique x filter x derivative source (only the drawn filter is compiled).
+``Renderer.created`` logs each GPU resource it builds, so tests (and curious users) can see exactly what a scene
+cost.
 """
 
 from __future__ import annotations
@@ -25,6 +27,16 @@ from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 from wgpuviewer.scene import Camera, Scene
 
 from . import autotable
+from .filters import (
+    DEFAULT_DERIVATIVES,
+    DEFAULT_FILTER,
+    FILTER_GROUP,
+    get_derivatives,
+    get_filter,
+    pack_filter_params,
+    resolve_filter_params,
+    sampler_descriptor,
+)
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_entries
 from .probe import probe
 from .shaders import MAX_LIGHTS, compose_technique, pack_trace_params, trace_params_size
@@ -33,12 +45,15 @@ from .techniques import AUTO_CANDIDATES, Technique, get_technique, resolve_param
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
 DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, depth, fetches
 LAYERS_FORMAT = "r32uint"  # offscreen: depth layers the search used per pixel
+FILTER_FORMAT = "rgba32uint"  # offscreen: the filter's texels, depth fetches, hidden | flags << 24, ratio bits
 DEPTH_FORMAT = "depth32float"
+#: The targets of an offscreen render (fs_data), in order.
+OFFSCREEN_FORMATS = (COLOR_FORMAT, DATA_FORMAT, LAYERS_FORMAT, FILTER_FORMAT)
 #: Byte size of entry/render.wgsl's Frame: view_proj, camera_pos, 8 scalars, lights (a test parses the WGSL).
 FRAME_SIZE = 64 + 16 + 32 + MAX_LIGHTS * 32
 
 #: Frame.mode values (render.wgsl).
-MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4}
+MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4, "albedo": 5}
 
 #: Draw configurations whose uniform buffer and bind group are kept per material (the least recently drawn are
 #: dropped): draws with different parameters can share one submit (the A/B split, the benchmark's batched frames).
@@ -50,23 +65,41 @@ _MATERIAL_FORMATS = {"albedo": "rgba16float", "normal": "rgba8unorm"}
 
 @dataclass(frozen=True)
 class DrawConfig:
-    """What one draw shows: a technique, all its parameter values, and optionally a relief depth (UV units) to
-    trace at instead of each material's own ``height_scale``. Build it with ``DrawConfig.of`` (checks the
-    parameters against the registry) or ``Renderer.config`` (starts from the scene's parameters)."""
+    """What one draw shows: a technique, all its parameter values, optionally a relief depth (UV units) to
+    trace at instead of each material's own ``height_scale``, and the texture filter (``relief.filters``) with
+    all its parameter values and the derivative source it is given. Build it with ``DrawConfig.of`` (checks
+    the parameters against the registries) or ``Renderer.config`` (starts from the scene's parameters)."""
 
     technique: str
     params: tuple[tuple[str, object], ...]  # (name, value) for every parameter of the technique
     height_scale: float | None = None
+    filter: str = DEFAULT_FILTER
+    filter_params: tuple[tuple[str, object], ...] = ()  # (name, value) for every parameter of the filter
+    derivatives: str = DEFAULT_DERIVATIVES
 
     @classmethod
-    def of(cls, technique: str, params: dict | None = None, height_scale: float | None = None) -> DrawConfig:
+    def of(cls, technique: str, params: dict | None = None, height_scale: float | None = None, *,
+           filter: str = DEFAULT_FILTER, filter_params: dict | None = None,
+           derivatives: str = DEFAULT_DERIVATIVES) -> DrawConfig:
         t = get_technique(technique)
-        return cls(t.name, tuple(resolve_params(t, params).items()), height_scale)
+        f = get_filter(filter)
+        return cls(t.name, tuple(resolve_params(t, params).items()), height_scale, f.name,
+                   tuple(resolve_filter_params(f, filter_params).items()), get_derivatives(derivatives).name)
 
     @property
     def values(self) -> dict:
         """The parameter values as a dict (a copy)."""
         return dict(self.params)
+
+    @property
+    def filter_values(self) -> dict:
+        """The filter's parameter values (defaults for any not given)."""
+        return {**get_filter(self.filter).defaults(), **dict(self.filter_params)}
+
+    @property
+    def label(self) -> str:
+        """Technique, filter and derivative source, e.g. 'pom / ewa_vis (displaced)'."""
+        return f"{self.technique} / {self.filter} ({self.derivatives})"
 
 
 @dataclass
@@ -75,6 +108,9 @@ class OffscreenImage:
     data: np.ndarray  # (H, W, 4) float32: hit u, hit v, hit depth, fetches (negative: capped)
     layers: np.ndarray | None = None  # (H, W) uint32: depth layers the search used (0: no layers)
     layer_range: tuple[float, float] = (0.0, 1.0)  # the layers mode's grey: (N - lo) / (hi - lo)
+    #: (H, W, 4) uint32: texels the filter read, depth fetches of its visibility traces and slopes,
+    #: hidden texels | flags << 24 (filters.FLAGS), the derivative source's raw length ratio as float32 bits.
+    filter: np.ndarray | None = None
 
     @property
     def covered(self) -> np.ndarray:
@@ -89,12 +125,14 @@ class Renderer:
         self.gpu = gpu
         self.created: list[str] = []  # GPU resources built, in order: "kind:name"
         self._material_groups: OrderedDict[tuple, tuple[wgpu.GPUBindGroup, wgpu.GPUBuffer]] = OrderedDict()
+        self._filter_groups: dict[tuple, wgpu.GPUBindGroup] = {}
         device = gpu.device
         U = wgpu.BufferUsage
         V, F = wgpu.ShaderStage.VERTEX, wgpu.ShaderStage.FRAGMENT
         if like is not None:
             self._textures, self._pipelines, self._material_layouts = like._textures, like._pipelines, like._material_layouts
             self._frame_layout, self._object_layout, self._sampler = like._frame_layout, like._object_layout, like._sampler
+            self._filter_layout, self._samplers = like._filter_layout, like._samplers
         else:
             self._textures: dict[tuple[str, str], wgpu.GPUTexture] = {}
             self._pipelines: dict[tuple, wgpu.GPURenderPipeline] = {}
@@ -109,6 +147,11 @@ class Renderer:
                 label="material", address_mode_u="repeat", address_mode_v="repeat",
                 mag_filter="linear", min_filter="linear", mipmap_filter="linear", max_anisotropy=1,
             )
+            self._filter_layout = device.create_bind_group_layout(
+                label="filter", entries=[{"binding": 0, "visibility": F, "buffer": {"type": "uniform"}},
+                                         {"binding": 1, "visibility": F, "sampler": {"type": "filtering"}}]
+            )
+            self._samplers: dict[tuple, wgpu.GPUSampler] = {}
         self._frame_buffer = device.create_buffer(label="frame", size=FRAME_SIZE, usage=U.UNIFORM | U.COPY_DST)
         self._frame_group = device.create_bind_group(
             layout=self._frame_layout, entries=[{"binding": 0, "resource": {"buffer": self._frame_buffer}}]
@@ -240,15 +283,44 @@ class Renderer:
             self._material_groups.popitem(last=False)
         return group, params
 
-    def pipeline(self, technique: Technique, formats: tuple[str, ...]) -> wgpu.GPURenderPipeline:
-        key = (technique.name, formats)
+    def _filter_group(self, draw: DrawConfig) -> wgpu.GPUBindGroup:
+        """The filter's uniform and sampler (group FILTER_GROUP), per filter and parameter values."""
+        key = (draw.filter, draw.filter_params)
+        if key not in self._filter_groups:
+            f = get_filter(draw.filter)
+            values = draw.filter_values
+            descriptor = sampler_descriptor(f, values)
+            sampler_key = tuple(sorted(descriptor.items()))
+            if sampler_key not in self._samplers:
+                self._samplers[sampler_key] = self.gpu.device.create_sampler(label=f"filter:{f.name}", **descriptor)
+            buffer = self.gpu.device.create_buffer_with_data(
+                label=f"filter:{f.name}", data=pack_filter_params(f, values), usage=wgpu.BufferUsage.UNIFORM
+            )
+            self._filter_groups[key] = self.gpu.device.create_bind_group(
+                layout=self._filter_layout,
+                entries=[{"binding": 0, "resource": {"buffer": buffer}},
+                         {"binding": 1, "resource": self._samplers[sampler_key]}],
+            )
+        return self._filter_groups[key]
+
+    def module(self, technique: Technique, filter: str = DEFAULT_FILTER, derivatives: str = DEFAULT_DERIVATIVES):
+        """The composed render module (``core.wgsl.Module``) of a technique with a filter and derivative source."""
+        return compose_technique(technique, "render", filter, derivatives)
+
+    def pipeline(self, technique: Technique, formats: tuple[str, ...], filter: str = DEFAULT_FILTER,
+                 derivatives: str = DEFAULT_DERIVATIVES) -> wgpu.GPURenderPipeline:
+        key = (technique.name, filter, derivatives, formats)
         if key not in self._pipelines:
             device = self.gpu.device
-            label = f"render:{technique.name}:{'+'.join(formats)}"
-            module = device.create_shader_module(label=label, code=compose_technique(technique, "render").code)
+            what = technique.name if (filter, derivatives) == (DEFAULT_FILTER, DEFAULT_DERIVATIVES) \
+                else f"{technique.name}/{filter}/{derivatives}"
+            label = f"render:{what}:{'+'.join(formats)}"
+            code = self.module(technique, filter, derivatives).code
+            module = device.create_shader_module(label=label, code=code)
             layout = device.create_pipeline_layout(
                 label=label,
-                bind_group_layouts=[self._frame_layout, self._material_layout(technique), self._object_layout],
+                bind_group_layouts=[self._frame_layout, self._material_layout(technique), self._object_layout,
+                                    self._filter_layout],
             )
             self._pipelines[key] = device.create_render_pipeline(
                 label=label,
@@ -267,29 +339,41 @@ class Renderer:
                     "targets": [{"format": f} for f in formats],
                 },
             )
-            self.created.append(f"pipeline:{technique.name}:{'+'.join(formats)}")
+            self.created.append(f"pipeline:{what}:{'+'.join(formats)}")
         return self._pipelines[key]
 
     # --- frames ------------------------------------------------------------------------------
 
-    def rebuild_pipelines(self) -> list[tuple[Technique, Exception]]:
+    def rebuild_pipelines(self) -> list[tuple[Technique, str]]:
         """Compile every cached pipeline again from the WGSL files (hot reload). A pipeline that fails keeps
-        its previous version; returns (technique, error) for each failure."""
+        its previous version; returns (technique, message) for each failure, the message located in the WGSL
+        file (``file:line:column: reason``, core.wgsl.Module.locate)."""
         failures = []
         for key in list(self._pipelines):
-            technique = get_technique(key[0])
+            name, filter, derivatives, formats = key
+            technique = get_technique(name)
             old = self._pipelines.pop(key)
             try:
-                self.pipeline(technique, key[1])
+                self.pipeline(technique, formats, filter, derivatives)
             except wgpu.GPUError as error:
                 self._pipelines[key] = old
-                failures.append((technique, error))
+                try:
+                    message = self.module(technique, filter, derivatives).locate(str(error))
+                except OSError as read_error:
+                    message = str(read_error)
+                failures.append((technique, message))
+            except OSError as error:  # a WGSL file vanished mid-edit
+                self._pipelines[key] = old
+                failures.append((technique, str(error)))
         return failures
 
-    def config(self, technique: str, params: dict | None = None, height_scale: float | None = None) -> DrawConfig:
-        """A DrawConfig for ``technique`` starting from the scene's parameters for it, ``params`` overriding."""
+    def config(self, technique: str, params: dict | None = None, height_scale: float | None = None,
+               **filtering) -> DrawConfig:
+        """A DrawConfig for ``technique`` starting from the scene's parameters for it, ``params`` overriding;
+        ``filtering``: DrawConfig.of's filter, filter_params and derivatives."""
         name = get_technique(technique).name
-        return DrawConfig.of(name, {**self.scene.technique_params.get(name, {}), **(params or {})}, height_scale)
+        return DrawConfig.of(name, {**self.scene.technique_params.get(name, {}), **(params or {})}, height_scale,
+                             **filtering)
 
     def _write_frame(self, camera: Camera, size: tuple[int, int], mode: str, technique: Technique, params: dict):
         w, h = size
@@ -326,8 +410,8 @@ class Renderer:
         scissor: tuple[int, int, int, int] | None = None,
         timestamp_writes: dict | None = None,
     ) -> None:
-        """Record one frame of ``draw`` into ``color_views`` (1 target: fs_color; 3: fs_data, formats
-        (COLOR_FORMAT, DATA_FORMAT, LAYERS_FORMAT)).
+        """Record one frame of ``draw`` into ``color_views`` (1 target: fs_color; 4: fs_data, formats
+        OFFSCREEN_FORMATS).
 
         ``clear=False`` keeps what the targets hold and ``scissor`` (x, y, w, h) limits the drawing:
         together they put several techniques side by side in one frame. ``timestamp_writes`` goes to
@@ -336,7 +420,8 @@ class Renderer:
         technique = get_technique(draw.technique)
         params = draw.values
         self._write_frame(camera, size, mode, technique, params)
-        pipeline = self.pipeline(technique, formats)
+        pipeline = self.pipeline(technique, formats, draw.filter, draw.derivatives)
+        filter_group = self._filter_group(draw)
         groups = {}
         for material_name in {m for m, *_ in self._objects}:
             group, params_buffer = self._material_group(material_name, technique, draw)
@@ -367,6 +452,7 @@ class Renderer:
             rpass.set_scissor_rect(*scissor)
         rpass.set_pipeline(pipeline)
         rpass.set_bind_group(0, self._frame_group)
+        rpass.set_bind_group(FILTER_GROUP, filter_group)
         for material_name, vbuf, count, object_group in self._objects:
             rpass.set_bind_group(1, groups[material_name])
             rpass.set_bind_group(2, object_group)
@@ -374,9 +460,11 @@ class Renderer:
             rpass.draw(count)
         rpass.end()
 
-    def render(self, draw: DrawConfig | str, size: tuple[int, int], camera: Camera | None = None) -> OffscreenImage:
-        """Draw offscreen and read back both the colour and the raw trace data. ``draw``: a DrawConfig, or a
-        technique name (drawn with the scene's parameters for it)."""
+    def render(self, draw: DrawConfig | str, size: tuple[int, int], camera: Camera | None = None,
+               mode: str = "color") -> OffscreenImage:
+        """Draw offscreen and read back the colour, the raw trace data and the filter's statistics. ``draw``: a
+        DrawConfig, or a technique name (drawn with the scene's parameters for it). ``mode`` "albedo" makes the
+        colour the filtered albedo, unlit; every other mode reads the shaded colour."""
         if isinstance(draw, str):
             draw = self.config(draw)
         device = self.gpu.device
@@ -385,13 +473,15 @@ class Renderer:
         color = device.create_texture(label="offscreen:color", size=(w, h, 1), format=COLOR_FORMAT, usage=usage)
         data = device.create_texture(label="offscreen:data", size=(w, h, 1), format=DATA_FORMAT, usage=usage)
         layers = device.create_texture(label="offscreen:layers", size=(w, h, 1), format=LAYERS_FORMAT, usage=usage)
+        stats = device.create_texture(label="offscreen:filter", size=(w, h, 1), format=FILTER_FORMAT, usage=usage)
         depth = device.create_texture(
             label="offscreen:depth", size=(w, h, 1), format=DEPTH_FORMAT, usage=wgpu.TextureUsage.RENDER_ATTACHMENT
         )
         encoder = device.create_command_encoder(label="offscreen")
         self.encode(
-            encoder, [color.create_view(), data.create_view(), layers.create_view()], depth.create_view(),
-            (COLOR_FORMAT, DATA_FORMAT, LAYERS_FORMAT), draw, camera or self.scene.camera, size,
+            encoder, [color.create_view(), data.create_view(), layers.create_view(), stats.create_view()],
+            depth.create_view(), OFFSCREEN_FORMATS, draw,
+            camera or self.scene.camera, size, "albedo" if mode == "albedo" else "color",
         )
         device.queue.submit([encoder.finish()])
         return OffscreenImage(
@@ -399,6 +489,7 @@ class Renderer:
             data=_read_texture(device, data, 4, np.uint32).view(np.float32),
             layers=_read_texture(device, layers, 1, np.uint32)[:, :, 0],
             layer_range=layer_range(draw.values),
+            filter=_read_texture(device, stats, 4, np.uint32),
         )
 
 

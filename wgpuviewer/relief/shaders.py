@@ -3,8 +3,11 @@
 A module = the generated interface (``interface``: the technique's ``TraceParams`` struct, its ``NAME_MIN`` /
 ``NAME_MAX`` parameter constants, ``MAX_LAYERS``, and the @group(1) binding lines of the uniform, the sampler and
 every texture slot it needs) + the technique's file (with what it includes from ``wgsl/common/``) + for rendering
-a shading-normal snippet + an entry-point file (``entry/render.wgsl`` or ``entry/probe.wgsl``), composed by
-``wgpuviewer.core.wgsl`` (includes, line map for error locations).
+and the filter probe the texture filter (``filters.filter_interface`` and ``wgsl/filters/NAME.wgsl``, with a
+visibility snippet for the texel-loop filters) + for rendering a derivative source (``wgsl/derivatives/``) and a
+shading-normal snippet + an entry-point file (``entry/render.wgsl``, ``entry/probe.wgsl`` or
+``entry/filter_probe.wgsl``), composed by ``wgpuviewer.core.wgsl`` (includes, line map for error locations).
+Only the draw's filter and derivative source are compiled.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import numpy as np
 from wgpuviewer.core.wgsl import Generated, Module, compose
 from wgpuviewer.scene import MAX_LIGHTS
 
+from .filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, filter_interface, get_derivatives, get_filter
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding
 from .techniques import MAX_LAYERS, Technique
 
@@ -47,10 +51,25 @@ def interface(technique: Technique, entry: str) -> Generated:
     return Generated(f"<generated: {technique.name} interface>", "\n".join(lines) + "\n")
 
 
-def compose_technique(technique: Technique, entry: str) -> Module:
-    """The module for ``technique`` with entry point file ``entry/ENTRY.wgsl`` ('render' or 'probe')."""
+def traces_relief(technique: Technique) -> bool:
+    """Whether the technique's hit depends on a depth map (then footprints can be displaced and texels hidden)."""
+    return technique.ray_search and technique.needs_depth
+
+
+def compose_technique(technique: Technique, entry: str, filter: str = DEFAULT_FILTER,
+                      derivatives: str = DEFAULT_DERIVATIVES) -> Module:
+    """The module for ``technique`` with entry point file ``entry/ENTRY.wgsl`` ('render', 'probe' or
+    'filter_probe'); ``filter`` and ``derivatives`` name the texture filter and derivative source (render)."""
     parts = [interface(technique, entry), technique.wgsl_file]
+    if entry in ("render", "filter_probe"):
+        f = get_filter(filter)
+        parts += [filter_interface(f), f.wgsl_file]
+        if f.texel_loop:
+            traced = f.visibility and traces_relief(technique)
+            parts.append("visibility/traced.wgsl" if traced else "visibility/none.wgsl")
     if entry == "render":
+        source = get_derivatives(derivatives)
+        parts.append(source.wgsl_file if traces_relief(technique) or not source.traced else "derivatives/uv.wgsl")
         parts.append("shading/normal_from_map.wgsl" if "normal" in technique.textures else "shading/normal_flat.wgsl")
     parts.append(f"entry/{entry}.wgsl")
     return compose(*parts)

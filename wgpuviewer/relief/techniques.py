@@ -53,8 +53,21 @@ class Param:
         return self.kind(value)
 
 
+class Parametrized:
+    """A registry entry with ``params`` (a tuple of Param): lookup by name and the default values."""
+
+    def param(self, name: str) -> Param:
+        for p in self.params:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def defaults(self) -> dict:
+        return {p.name: p.kind(p.default) for p in self.params}
+
+
 @dataclass(frozen=True)
-class Technique:
+class Technique(Parametrized):
     name: str
     key: str  # default keyboard key in the viewer
     description: str
@@ -86,15 +99,6 @@ class Technique:
     @property
     def needs_depth(self) -> bool:
         return "depth" in self.textures
-
-    def param(self, name: str) -> Param:
-        for p in self.params:
-            if p.name == name:
-                return p
-        raise KeyError(name)
-
-    def defaults(self) -> dict:
-        return {p.name: p.kind(p.default) for p in self.params}
 
     def cost_scale(self, params: dict) -> float:
         """Fetch count drawn as full heat in the cost view: the search's own bound where its parameters
@@ -283,8 +287,9 @@ def get_technique(name: str, where: str = "technique") -> Technique:
         raise UserError(f"{where} = {name!r}: unknown technique; expected one of {', '.join(TECHNIQUES)}") from None
 
 
-def resolve_params(technique: Technique, overrides: dict | None = None, where: str = "") -> dict:
-    """Defaults merged with checked overrides (unknown names are errors naming ``where``)."""
+def resolve_params(technique: Technique, overrides: dict | None = None, where: str = "", kind: str = "technique") -> dict:
+    """Defaults merged with checked overrides (unknown names are errors naming ``where``). Also for other registry
+    entries with ``name``, ``params``, ``param()`` and ``defaults()`` (texture filters: ``kind="filter"``)."""
     values = technique.defaults()
     for name, value in (overrides or {}).items():
         key = f"{where}{name}" if where else f"{technique.name}.{name}"
@@ -292,6 +297,6 @@ def resolve_params(technique: Technique, overrides: dict | None = None, where: s
             param = technique.param(name)
         except KeyError:
             known = ", ".join(p.name for p in technique.params) or "none"
-            raise UserError(f"{key}: unknown parameter of technique {technique.name!r}; known: {known}") from None
+            raise UserError(f"{key}: unknown parameter of {kind} {technique.name!r}; known: {known}") from None
         values[name] = param.validate(value, key)
     return values

@@ -1,8 +1,9 @@
 """The interactive window: rendercanvas (glfw by default, Qt on request) on any wgpu backend.
 
-Compare relief-mapping techniques live: number keys and Left/Right switch techniques, B splits the
-screen between two of them (drag the divider), Shift+D shows the cost (depth fetches per pixel) and
-Shift+E the UV error against a high-layer-count POM reference, both as heat maps with a legend.
+Compare relief-mapping techniques live: number keys and Left/Right switch techniques, F the texture filter
+(Shift+F its derivative source), B splits the screen between two techniques or filters (drag the divider),
+Shift+D shows the cost (depth fetches per pixel) and Shift+E the UV error against a high-layer-count POM
+reference, both as heat maps with a legend.
 A HUD (imgui) shows FPS/frame/GPU time, the technique's description and live parameters, and the
 keys (F1). Edited WGSL files are recompiled on the fly. Settings persist between sessions
 (``settings``). ``keys.CONTROLS`` lists every key.
@@ -10,9 +11,10 @@ keys (F1). Edited WGSL files are recompiled on the fly. Settings persist between
 Scripted runs (tests, demos): ``frames`` frames, ``keys`` pressed one per frame, the last frame
 (HUD included) saved to ``screenshot``; an ERROR logged while drawing makes the run exit 1.
 
-The viewer owns what the user tunes live: the parameters of each technique (``params``, starting from the scene's)
-and a relief-depth override per technique (``height_scales``); each pass gets them as a frozen
-``DrawConfig`` (``draw_config``).
+The viewer owns what the user tunes live: the parameters of each technique (``params``, starting from the scene's),
+a relief-depth override per technique (``height_scales``), the texture filter and derivative source of each A/B
+half (``filters``, ``derivative_sources``) and each filter's parameters (``filter_params``); each pass gets them as
+a frozen ``DrawConfig`` (``draw_config``).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from wgpuviewer.core.cli import terminal_progress
 from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.core.gpu import get_gpu
 from wgpuviewer.core.io import refuse_directory
+from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, DERIVATIVE_SOURCES, FILTERS, get_filter
 from wgpuviewer.relief.output import save_rgb_png
 from wgpuviewer.relief.renderer import DEPTH_FORMAT, DrawConfig, Renderer
 from wgpuviewer.relief.techniques import get_technique
@@ -80,6 +83,8 @@ class Viewer:
         hud: bool = True,
         scripted: bool = False,
         background: bool | None = None,
+        filter: str = DEFAULT_FILTER,
+        derivatives: str = DEFAULT_DERIVATIVES,
     ):
         RenderCanvas, self.loop = _canvas_class(gui)
         self.gui = gui
@@ -106,6 +111,10 @@ class Viewer:
         self.technique = technique
         self.technique_b = self.techniques[(self.techniques.index(technique) + 1) % len(self.techniques)]
         self.active_side = "A"
+        #: Texture filter and derivative source per A/B half, and the live parameters of each filter.
+        self.filters = {"A": filter, "B": filter}
+        self.derivative_sources = {"A": derivatives, "B": derivatives}
+        self.filter_params = {name: f.defaults() for name, f in FILTERS.items()}
         self.split = False
         self.split_x = 0.5
         self.mode = "color"
@@ -318,9 +327,20 @@ class Viewer:
         """The live parameters of technique ``name`` (the dict the HUD edits)."""
         return self.params.setdefault(name, get_technique(name).defaults())
 
-    def draw_config(self, name: str) -> DrawConfig:
-        """What a pass of technique ``name`` draws: its live parameters and height-scale override."""
-        return DrawConfig.of(name, self.technique_params(name), self.height_scales.get(name))
+    def draw_config(self, name: str, side: str = "A") -> DrawConfig:
+        """What a pass of technique ``name`` draws in half ``side``: its live parameters and height-scale override,
+        the half's filter with its live parameters and the half's derivative source."""
+        f = self.filters[side]
+        return DrawConfig.of(name, self.technique_params(name), self.height_scales.get(name), filter=f,
+                             filter_params=self.filter_params[f], derivatives=self.derivative_sources[side])
+
+    @property
+    def side(self) -> str:
+        """The half the keys change: B only while the screen is split and B is active."""
+        return "B" if self.split and self.active_side == "B" else "A"
+
+    def filter_label(self, side: str = "A") -> str:
+        return f"{self.filters[side]} ({self.derivative_sources[side]})"
 
     def cost_scale(self) -> float:
         return get_technique(self.technique).cost_scale(self.technique_params(self.technique))
@@ -357,6 +377,22 @@ class Viewer:
         number = int(key) or 10  # keys 1..9, then 0 for the 10th
         if number <= len(self.techniques):
             self.set_technique(self.techniques[number - 1])
+
+    def cycle_filter(self, key: str):
+        names = list(FILTERS)
+        side = self.side
+        self.filters[side] = names[(names.index(self.filters[side]) + 1) % len(names)]
+        if not self.split:
+            self.filters["B"] = self.filters["A"]
+
+    def cycle_derivatives(self, key: str):
+        names = list(DERIVATIVE_SOURCES)
+        side = self.side
+        self.derivative_sources[side] = names[(names.index(self.derivative_sources[side]) + 1) % len(names)]
+        if not get_filter(self.filters[side]).uses_derivatives:
+            self.message(f"{self.filters[side]} reads level 0: the derivative source does not change it")
+        if not self.split:
+            self.derivative_sources["B"] = self.derivative_sources["A"]
 
     def cycle_technique(self, key: str):
         step = 1 if key == "ArrowRight" else -1
@@ -453,25 +489,27 @@ class Viewer:
             self.move_speed = float(np.clip(self.move_speed * 1.1 ** (-steps), lo, hi))
 
     def _update_title(self):
-        what = f"{self.technique} | {self.technique_b}" if self.split else self.technique
+        a = f"{self.technique} {self.filter_label('A')}"
+        what = f"{a} | {self.technique_b} {self.filter_label('B')}" if self.split else a
         self.canvas.set_title(f"wgpuviewer - {self.scene.name} - {what} ({self.mode})")
 
     # --- frames ------------------------------------------------------------------------------
 
     def _scene_passes(self, w: int, h: int, camera: Camera) -> list:
-        """(technique, scissor) of the passes that draw the scene: one, or the two halves of A/B."""
+        """(DrawConfig, scissor) of the passes that draw the scene: one, or the two halves of A/B."""
         if not self.split:
-            return [(self.technique, None)]
+            return [(self.draw_config(self.technique), None)]
         xs = int(np.clip(round(self.split_x * w), 1, w - 1)) if w > 1 else 1
-        return [(self.technique, (0, 0, xs, h)), (self.technique_b, (xs, 0, w - xs, h))]
+        return [(self.draw_config(self.technique, "A"), (0, 0, xs, h)),
+                (self.draw_config(self.technique_b, "B"), (xs, 0, w - xs, h))]
 
     def _update_error_view(self, w: int, h: int, camera: Camera, now: float):
         """Recompute the error map when what it shows changed (at most ~3 times a second)."""
         from . import error_view
 
         size = error_view.map_size((w, h))
-        techniques = (self.technique, self.technique_b) if self.split else (self.technique,)
-        draws = [self.draw_config(t) for t in techniques]
+        halves = [(self.technique, "A"), (self.technique_b, "B")] if self.split else [(self.technique, "A")]
+        draws = [self.draw_config(t, side) for t, side in halves]
         key = (size, tuple(draws), self.split and round(self.split_x, 3), camera)
         if key == self._error_key or (self._error_key is not None and now - self._error_time < 0.3):
             return
@@ -533,11 +571,11 @@ class Viewer:
         if self.timer:
             self.timer.begin_frame()
         # One submit per scene pass: each pass writes the renderer's frame/params uniforms first.
-        for i, (technique, scissor) in enumerate(passes):
+        for i, (draw, scissor) in enumerate(passes):
             encoder = device.create_command_encoder(label="window")
             writes = self.timer.writes(i == 0, i == len(passes) - 1) if self.timer else None
             self.renderer.encode(
-                encoder, [view], self._depth.create_view(), (self.format,), self.draw_config(technique), camera, (w, h),
+                encoder, [view], self._depth.create_view(), (self.format,), draw, camera, (w, h),
                 scene_mode, clear=(i == 0), scissor=scissor, timestamp_writes=writes,
             )
             if self.timer and i == len(passes) - 1:
@@ -653,6 +691,7 @@ def save_session(settings: Settings) -> None:
 def run_viewer(
     scene: Scene, technique: str, *, backend=None, frames=None, screenshot=None, keys=(),
     gui: str = "glfw", settings: Settings | None = None, size=None, save: bool | None = None,
+    filter: str = DEFAULT_FILTER, derivatives: str = DEFAULT_DERIVATIVES,
 ) -> int:
     """Open the window. Interactive runs save the settings on exit (``save``); scripted ones don't."""
     if frames is not None and frames < 1:
@@ -667,9 +706,10 @@ def run_viewer(
     if unknown:
         raise UserError(f"--keys: unknown key {unknown[0]!r}; known: {', '.join(sorted(PRESSED))}")
     scripted = frames is not None
-    viewer = Viewer(scene, technique, backend, gui=gui, settings=settings, size=size, scripted=scripted)
+    viewer = Viewer(scene, technique, backend, gui=gui, settings=settings, size=size, scripted=scripted,
+                    filter=filter, derivatives=derivatives)
     if not scripted:
-        print("keys: F1 help, 1-9 technique, B A/B split, Shift+D cost, Shift+E error, H hide UI, Esc quit",
+        print("keys: F1 help, 1-9 technique, F filter, B A/B split, Shift+D cost, Shift+E error, H hide UI, Esc quit",
               file=sys.stderr)
     code = viewer.run(frames, screenshot, keys)
     if save if save is not None else not scripted:

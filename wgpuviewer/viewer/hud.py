@@ -1,6 +1,7 @@
 """The viewer's on-screen UI (Dear ImGui through ``wgpu.utils.imgui``, package ``imgui-bundle``).
 
-Panels: statistics (X), info with the technique's description and live parameters, help (F1),
+Panels: statistics (X), info with the technique's description and live parameters and the texture filter (F,
+Shift+F: its derivative source) with its parameters, help (F1),
 a colour legend in the cost and error views, labels of the A/B halves, status and shader errors.
 H hides everything. The HUD draws into the frame in its own render pass, after the scene.
 """
@@ -20,6 +21,7 @@ import numpy as np
 
 from wgpuviewer.core.color import heat, linear_to_srgb
 from wgpuviewer.relief import autotable
+from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS, get_filter
 from wgpuviewer.relief.maps import height_scale_adjustable
 from wgpuviewer.relief.techniques import get_technique
 
@@ -126,11 +128,10 @@ class Hud:
         self._record("stats")
         imgui.end()
 
-    def _params(self, technique_name: str, tag: str) -> None:
-        v = self.viewer
-        technique = get_technique(technique_name)
-        values = v.technique_params(technique_name)
-        for p in technique.params:
+    @staticmethod
+    def _sliders(params, values: dict, tag: str) -> None:
+        """One widget per registry parameter (checkbox, int or float slider within its range), editing ``values``."""
+        for p in params:
             label = f"{p.name}##{tag}"
             current = values.get(p.name, p.default)
             if p.kind is bool:
@@ -144,6 +145,11 @@ class Hud:
                 values[p.name] = p.kind(new)
             if imgui.is_item_hovered():
                 imgui.set_tooltip(p.doc)
+
+    def _params(self, technique_name: str, tag: str) -> None:
+        v = self.viewer
+        technique = get_technique(technique_name)
+        self._sliders(technique.params, v.technique_params(technique_name), tag)
         if technique.needs_depth and height_scale_adjustable(technique.textures):
             overrides = v.height_scales
             changed, on = imgui.checkbox(f"override height scale##{tag}", technique_name in overrides)
@@ -188,6 +194,7 @@ class Hud:
             if t.name == "auto":
                 for line in auto_lines(v.renderer, v.technique_params(name)["max_error"]):
                     imgui.text_colored(GREY, line)
+            self._filter(tag if v.split else "A", tag)
             imgui.separator()
         modes = ("color", "cost", "error")
         for i, mode in enumerate(modes):
@@ -211,6 +218,24 @@ class Hud:
         imgui.pop_item_width()
         self._record("info")
         imgui.end()
+
+    def _filter(self, side: str, tag: str) -> None:
+        """The half's texture filter (a combo, F cycles it), its derivative source (Shift+F) and parameters."""
+        v = self.viewer
+        names = list(FILTERS)
+        changed, index = imgui.combo(f"filter (F)##{tag}", names.index(v.filters[side]), names)
+        if changed:
+            v.filters[side] = names[index]
+        if imgui.is_item_hovered():
+            imgui.set_tooltip(get_filter(v.filters[side]).description)
+        sources = list(DERIVATIVE_SOURCES)
+        changed, index = imgui.combo(f"derivatives (Shift+F)##{tag}", sources.index(v.derivative_sources[side]), sources)
+        if changed:
+            v.derivative_sources[side] = sources[index]
+        if imgui.is_item_hovered():
+            imgui.set_tooltip(DERIVATIVE_SOURCES[v.derivative_sources[side]].description)
+        f = get_filter(v.filters[side])
+        self._sliders(f.params, v.filter_params[f.name], f"{tag}:{f.name}")
 
     def _help_panel(self, flags, width, height) -> None:
         imgui.set_next_window_pos((width / 2, height / 2), imgui.Cond_.appearing, (0.5, 0.5))
@@ -260,7 +285,7 @@ class Hud:
         draw.add_line((x, 0), (x, imgui.get_io().display_size[1]), white, 2.0)
         height = imgui.get_io().display_size[1]
         for tag, name, cx in (("A", v.technique, x / 2), ("B", v.technique_b, (x + width) / 2)):
-            text = f"{tag}: {name}"
+            text = f"{tag}: {name} / {v.filter_label(tag)}"
             size = imgui.calc_text_size(text)
             pos = (cx - size.x / 2, height - size.y - 10)
             draw.add_rect_filled((pos[0] - 6, pos[1] - 4), (pos[0] + size.x + 6, pos[1] + size.y + 4),

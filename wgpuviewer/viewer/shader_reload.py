@@ -10,7 +10,6 @@ import contextlib
 from pathlib import Path
 
 from wgpuviewer.core.wgsl import wgsl_dir
-from wgpuviewer.relief.shaders import compose_technique
 
 
 class ShaderReloader:
@@ -48,11 +47,7 @@ class ShaderReloader:
     def reload(self) -> list[str]:
         """Rebuild every cached pipeline; on failure keep the old one. Returns (and keeps) the errors."""
         errors = []
-        for technique, error in self.renderer.rebuild_pipelines():
-            try:
-                located = compose_technique(technique, "render").locate(str(error))
-            except OSError as read_error:
-                located = str(read_error)
+        for _technique, located in self.renderer.rebuild_pipelines():
             if located not in errors:
                 errors.append(located)
         self.errors = errors

@@ -1,6 +1,7 @@
 // Compute probe: runs a technique's `trace` on given rays (the same function the fragment path
 // uses), at mip level 0, and writes what it found per ray. ProbeRay and ProbeHit are checked against
 // wgpuviewer/relief/probe.py's strides by a test.
+// #include "common/probe_index.wgsl"
 
 struct ProbeRay {
     uv: vec2f,
@@ -23,8 +24,7 @@ struct ProbeHit {
 
 @compute @workgroup_size(64)
 fn probe_main(@builtin(global_invocation_id) id: vec3u, @builtin(num_workgroups) groups: vec3u) {
-    // Large ray sets are dispatched as a 2D grid of workgroups (65535 per dimension at most).
-    let i = id.x + id.y * groups.x * 64u;
+    let i = probe_index(id, groups);
     if i >= arrayLength(&rays) {
         return;
     }

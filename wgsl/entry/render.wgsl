@@ -1,15 +1,19 @@
-// Rasterisation entry points: vertex transform, then per fragment the technique's `trace` and the
-// thesis' shading model (ambient 0.2 * albedo, Lambert diffuse, Blinn-Phong 0.2 * pow(., 32)).
-// Composed after the generated interface (MAX_LIGHTS among it), one technique file and one shading_normal
+// Rasterisation entry points: vertex transform, then per fragment the technique's `trace`, the texture
+// filter's lookups at the hit and the thesis' shading model (ambient 0.2 * albedo, Lambert diffuse,
+// Blinn-Phong 0.2 * pow(., 32)). Composed after the generated interfaces (MAX_LIGHTS among them), one technique
+// file, one filter (`filter_texture`), one derivative source (`texture_derivatives`) and one shading_normal
 // snippet (wgpuviewer/relief/shaders.py). Frame's layout is checked against renderer.FRAME_SIZE by a test.
 // #include "common/heat.wgsl"
+// #include "common/footprint.wgsl"
 
-// Frame.mode values of fs_color (the window); offscreen rendering reads fs_data's raw target instead.
+// Frame.mode values of fs_color (the window); offscreen rendering reads fs_data's raw targets instead, whose colour
+// follows MODE_ALBEDO too.
 const MODE_COLOR: u32 = 0u;
 const MODE_COST: u32 = 1u;
 const MODE_UV: u32 = 2u;
 const MODE_DEPTH: u32 = 3u;
 const MODE_LAYERS: u32 = 4u;
+const MODE_ALBEDO: u32 = 5u;  // the filtered albedo, unlit (the filtering study compares it)
 
 struct Light {
     vector: vec4f,  // w = 0: direction towards the light; w = 1: light position
@@ -71,6 +75,9 @@ struct Shaded {
     hit: TraceResult,
 }
 
+// The derivative source's raw length ratio of this fragment (the `filter` target's w).
+var<private> filter_ratio: f32;
+
 fn shade(in: VertexOut) -> Shaded {
     // Derivatives and mip level come from the unperturbed UV, before any non-uniform control flow:
     // they do not jump where the traced UV does (silhouettes, tiling seams).
@@ -87,13 +94,21 @@ fn shade(in: VertexOut) -> Shaded {
     let v_ts = vec3f(dot(to_eye, t_geo), dot(to_eye, b_geo), dot(to_eye, n_geo));
 
     let hit = trace(in.uv, v_ts, lod);
+    // The filters' footprint: derivatives from the draw's source, taken here, in uniform control flow.
+    let derivs = texture_derivatives(in.uv, v_ts, hit);
+    filter_stats.flags = derivs.flags;
+    filter_ratio = derivs.ratio;
     // A displaced UV outside the face means the ray left the relief through its side: a silhouette.
     if any(hit.uv < vec2f(0.0)) || any(hit.uv > object.uv_scale.xy) {
         discard;
     }
 
-    let albedo = textureSampleGrad(albedo_tex, material_sampler, hit.uv, duv_dx, duv_dy).rgb;
-    let n = shading_normal(hit.uv, duv_dx, duv_dy);
+    let fp = Footprint(hit.uv, derivs.dx, derivs.dy, v_ts, lod);
+    let albedo = filter_texture(albedo_tex, fp).rgb;
+    if frame.mode == MODE_ALBEDO {
+        return Shaded(albedo, hit);
+    }
+    let n = shading_normal(fp);
     var color = 0.2 * albedo;
     for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
         let light = frame.lights[i];
@@ -138,6 +153,9 @@ struct DataOut {
     // renderable everywhere (OpenGL ES), 32-bit integer targets are.
     @location(1) data: vec4u,
     @location(2) layers: u32,  // depth layers the search used (MODE_LAYERS / the `layers` output mode)
+    // texels the filter read, depth fetches of its visibility traces and slopes, hidden texels | flags << 24,
+    // the derivative source's raw length ratio as float bits (FilterStats, common/footprint.wgsl)
+    @location(3) filtering: vec4u,
 }
 
 // Offscreen output: the shaded colour plus the raw trace data (uv/depth/cost modes, .npy files).
@@ -146,5 +164,7 @@ fn fs_data(in: VertexOut) -> DataOut {
     let s = shade(in);
     let fetches = f32(s.hit.fetches);
     let data = vec4f(s.hit.uv, s.hit.depth, select(fetches, -fetches - 1.0, s.hit.capped));
-    return DataOut(vec4f(s.color, 1.0), bitcast<vec4u>(data), s.hit.layers);
+    let stats = vec4u(filter_stats.texels, filter_stats.depth_fetches,
+                      min(filter_stats.hidden, 0xffffffu) | (filter_stats.flags << 24u), bitcast<u32>(filter_ratio));
+    return DataOut(vec4f(s.color, 1.0), bitcast<vec4u>(data), s.hit.layers, stats);
 }

@@ -1,0 +1,135 @@
+"""Run a texture filter's WGSL ``filter_texture`` on arbitrary footprints in a compute shader.
+
+The probe composes the same filter (and, for the visibility filters, the same technique ``trace``) the fragment
+shader uses (``shaders.compose_technique(..., "filter_probe", filter)``), over a texture uploaded as the renderer
+uploads albedo (rgba16float, box-filtered mip chain). Tests compare it with the float64 filters of
+``wgpuviewer.studies.filtering.cpu`` on the same footprints, including ones no render produces (zero, NaN and
+huge derivatives).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import wgpu
+
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.gpu import Gpu, create_texture, get_gpu, mip_chain
+
+from .filters import FILTER_GROUP, get_filter, pack_filter_params, resolve_filter_params, sampler_descriptor
+from .maps import binding
+from .probe import dispatch, io_bind_group, io_layout_entries, material_bind_group, material_layout_entries
+from .shaders import compose_technique
+from .techniques import get_technique, resolve_params
+
+SAMPLE_STRIDE = 48  # FilterSample: vec2f uv, dx, dy, pad, vec4f view
+OUT_STRIDE = 32  # FilterOut: vec4f value, u32 texels, depth_fetches, hidden, flags
+TEXTURE_FORMAT = "rgba16float"  # as the renderer's albedo
+
+
+@dataclass
+class FilterProbeResult:
+    value: np.ndarray  # (N, 4) float32 filtered texel value
+    texels: np.ndarray  # (N,) uint32 texels read (hardware samples counted as the texels they blend)
+    depth_fetches: np.ndarray  # (N,) uint32 depth fetches of visibility traces
+    hidden: np.ndarray  # (N,) uint32 texels dropped as hidden
+    flags: np.ndarray  # (N,) uint32 filters.FLAGS bits
+
+
+def _pipeline(gpu: Gpu, technique_name: str, filter_name: str):
+    cache = gpu.cache.setdefault("filter_probe_pipelines", {})
+    key = (technique_name, filter_name)
+    if key not in cache:
+        technique = get_technique(technique_name)
+        device = gpu.device
+        code = compose_technique(technique, "filter_probe", filter_name).code
+        module = device.create_shader_module(label=f"filter-probe:{technique_name}/{filter_name}", code=code)
+        C = wgpu.ShaderStage.COMPUTE
+        layouts = [
+            device.create_bind_group_layout(label="filter-probe:io", entries=io_layout_entries(C)),
+            device.create_bind_group_layout(label="filter-probe:material",
+                                            entries=material_layout_entries(technique, ("albedo",))),
+        ]
+        layouts += [device.create_bind_group_layout(label="filter-probe:none", entries=[])] * (FILTER_GROUP - 2)
+        layouts.append(device.create_bind_group_layout(label="filter-probe:filter", entries=[
+            {"binding": 0, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.uniform}},
+            {"binding": 1, "visibility": C, "sampler": {"type": wgpu.SamplerBindingType.filtering}},
+        ]))
+        layout = device.create_pipeline_layout(label="filter-probe", bind_group_layouts=layouts)
+        pipeline = device.create_compute_pipeline(
+            label=f"filter-probe:{technique_name}/{filter_name}", layout=layout,
+            compute={"module": module, "entry_point": "filter_probe_main"},
+        )
+        cache[key] = (pipeline, layouts)
+    return cache[key]
+
+
+def texture_levels(texture: np.ndarray) -> list[np.ndarray]:
+    """The mip chain the probe uploads, as float64 arrays of the values the GPU holds (float16-rounded RGBA)."""
+    data = np.asarray(texture, np.float32)
+    if data.ndim == 2:
+        data = data[:, :, None]
+    if data.shape[2] < 4:
+        pad = np.ones(data.shape[:2] + (4 - data.shape[2],), np.float32)
+        data = np.concatenate([data, pad], axis=2)
+    return [np.asarray(level, np.float16).astype(np.float64) for level in mip_chain(data[:, :, :4])]
+
+
+def filter_probe(
+    filter: str,
+    texture: np.ndarray,
+    uv,
+    dx,
+    dy,
+    view_dir=(0.0, 0.0, 1.0),
+    *,
+    height: np.ndarray | None = None,
+    height_scale: float = 0.05,
+    technique: str = "maxmip",
+    filter_params: dict | None = None,
+    technique_params: dict | None = None,
+    backend: str | None = None,
+) -> FilterProbeResult:
+    """Filter ``texture`` (H, W, C) at N footprints on the GPU.
+
+    uv, dx, dy: (N, 2) the hit uv and its screen-space derivatives (UV units per pixel); view_dir: (N, 3) or
+    (3,) tangent-space V. With ``height`` (a height map in [0, 1], 1 = top) the module traces with
+    ``technique`` (default the exact ``maxmip``) and the visibility filters drop hidden texels; without it the
+    surface is flat (technique ``basic``).
+    """
+    f = get_filter(filter)
+    values = resolve_filter_params(f, filter_params)
+    tech = get_technique(technique if height is not None else "basic")
+    tech_values = resolve_params(tech, technique_params)
+    if height is None:
+        height = np.ones((1, 1))
+    height = np.asarray(height, np.float64)
+    if height.ndim != 2 or height.size == 0 or not np.isfinite(height).all():
+        raise UserError("filter probe: height must be a non-empty finite 2D array")
+    columns = [np.atleast_2d(np.asarray(a, np.float32)) for a in (uv, dx, dy, view_dir)]
+    n = max(len(c) for c in columns)
+    uv, dx, dy, view = (np.broadcast_to(c, (n, c.shape[1])) for c in columns)
+
+    gpu = get_gpu(backend, quiet=True)
+    device = gpu.device
+    pipeline, layouts = _pipeline(gpu, tech.name, f.name)
+    samples = np.zeros((n, SAMPLE_STRIDE // 4), np.float32)
+    samples[:, 0:2], samples[:, 2:4], samples[:, 4:6], samples[:, 8:11] = uv, dx, dy, view
+    S = wgpu.BufferUsage
+    in_buf = device.create_buffer_with_data(label="filter-probe:samples", data=samples, usage=S.STORAGE)
+    out_buf = device.create_buffer(label="filter-probe:out", size=n * OUT_STRIDE, usage=S.STORAGE | S.COPY_SRC)
+    albedo = create_texture(gpu, mip_chain(np.asarray(texture, np.float32)), TEXTURE_FORMAT, "filter-probe:texture")
+    material = material_bind_group(gpu, layouts[1], tech, height, height_scale, tech_values, "repeat",
+                                   extra=((binding("albedo"), albedo),))
+    params = device.create_buffer_with_data(label="filter-probe:params", data=pack_filter_params(f, values),
+                                            usage=S.UNIFORM)
+    sampler = device.create_sampler(label=f"filter-probe:{f.name}", **sampler_descriptor(f, values))
+    filter_group = device.create_bind_group(layout=layouts[FILTER_GROUP], entries=[
+        {"binding": 0, "resource": {"buffer": params}}, {"binding": 1, "resource": sampler}])
+    groups = [io_bind_group(gpu, layouts[0], in_buf, out_buf), material]
+    groups += [None] * (FILTER_GROUP - 2) + [filter_group]
+    raw = dispatch(gpu, pipeline, groups, n, out_buf, OUT_STRIDE)
+    u32 = raw.view(np.uint32)
+    return FilterProbeResult(value=raw.view(np.float32)[:, 0:4].copy(), texels=u32[:, 4].copy(),
+                             depth_fetches=u32[:, 5].copy(), hidden=u32[:, 6].copy(), flags=u32[:, 7].copy())
