@@ -179,6 +179,29 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def cmd_refined_distance(args) -> int:
+    from wgpuviewer.studies.refined_distance.run import run
+
+    def names(text, option):
+        items = [x.strip() for x in text.split(",") if x.strip()]
+        if not items:
+            raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
+        return items
+
+    angles = None
+    if args.angles:
+        try:
+            angles = [float(x) for x in names(args.angles, "--angles")]
+        except ValueError:
+            raise UserError(f"--angles {args.angles!r}: expected comma-separated degrees, e.g. 45,80") from None
+        if not all(0.0 <= a <= 85.0 for a in angles):
+            raise UserError(f"--angles {args.angles!r}: expected degrees from 0 to 85")
+    heightmaps = names(args.heightmaps, "--heightmaps") if args.heightmaps else None
+    run(args.suite, Path(args.out), heightmaps=heightmaps, angles=angles, progress=not args.quiet)
+    print(f"wrote {Path(args.out) / 'report.md'}")
+    return 0
+
+
 def cmd_info(args) -> int:
     from wgpuviewer.core.gpu import describe_adapters
 
@@ -240,13 +263,23 @@ def build_parser() -> argparse.ArgumentParser:
                        help="measure nothing: write report.md and plots from these results.csv files into --out")
     bench.set_defaults(func=cmd_bench)
 
+    refined = sub.add_parser("refined-distance", help="fetches of the distance tracer on every distance-map "
+                             "variant, on the benchmark's views (results.csv, report.md)")
+    refined.add_argument("--out", required=True, help="output folder (results.csv, report.md)")
+    refined.add_argument("--suite", choices=("smoke", "full"), default="full",
+                         help="smoke: two small maps, two angles; full: the benchmark's real maps and wall, 0-80 degrees")
+    refined.add_argument("--heightmaps", help="comma-separated: builtins and/or scikit-image brick,grass,gravel")
+    refined.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 85)")
+    refined.add_argument("--quiet", action="store_true", help="no progress bar")
+    refined.set_defaults(func=cmd_refined_distance)
+
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
     info.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     info.set_defaults(func=cmd_info)
     return parser
 
 
-COMMANDS = ("view", "render", "techniques", "accuracy", "bench", "info")
+COMMANDS = ("view", "render", "techniques", "accuracy", "bench", "refined-distance", "info")
 
 
 def main(argv: list[str] | None = None) -> int:
