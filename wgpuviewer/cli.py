@@ -138,23 +138,30 @@ def cmd_accuracy(args) -> int:
     return 0
 
 
+def names(text: str | None, option: str) -> list[str] | None:
+    """A comma-separated option value as a list (None when the option was not given)."""
+    if text is None:
+        return None
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    if not items:
+        raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
+    return items
+
+
+def angle_list(text: str | None) -> list[float] | None:
+    """--angles as degrees (None when not given)."""
+    if text is None:
+        return None
+    try:
+        return [float(x) for x in names(text, "--angles")]
+    except ValueError:
+        raise UserError(f"--angles {text!r}: expected comma-separated degrees, e.g. 0,45,80") from None
+
+
 def cmd_bench(args) -> int:
     from wgpuviewer.bench.run import resolve_options, run
 
-    def names(text, option):
-        if text is None:
-            return None
-        items = [x.strip() for x in text.split(",") if x.strip()]
-        if not items:
-            raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
-        return items
-
-    angles = None
-    if args.angles:
-        try:
-            angles = [float(x) for x in names(args.angles, "--angles")]
-        except ValueError:
-            raise UserError(f"--angles {args.angles!r}: expected comma-separated degrees, e.g. 0,45,80") from None
+    angles = angle_list(args.angles)
     resolution = None
     if args.resolution:
         try:
@@ -182,21 +189,10 @@ def cmd_bench(args) -> int:
 def cmd_refined_distance(args) -> int:
     from wgpuviewer.studies.refined_distance.run import run
 
-    def names(text, option):
-        items = [x.strip() for x in text.split(",") if x.strip()]
-        if not items:
-            raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
-        return items
-
-    angles = None
-    if args.angles:
-        try:
-            angles = [float(x) for x in names(args.angles, "--angles")]
-        except ValueError:
-            raise UserError(f"--angles {args.angles!r}: expected comma-separated degrees, e.g. 45,80") from None
-        if not all(0.0 <= a <= 85.0 for a in angles):
-            raise UserError(f"--angles {args.angles!r}: expected degrees from 0 to 85")
-    heightmaps = names(args.heightmaps, "--heightmaps") if args.heightmaps else None
+    angles = angle_list(args.angles)
+    if angles is not None and not all(0.0 <= a <= 85.0 for a in angles):
+        raise UserError(f"--angles {args.angles!r}: expected degrees from 0 to 85")
+    heightmaps = names(args.heightmaps, "--heightmaps")
     run(args.suite, Path(args.out), heightmaps=heightmaps, angles=angles, progress=not args.quiet)
     print(f"wrote {Path(args.out) / 'report.md'}")
     return 0

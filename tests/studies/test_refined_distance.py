@@ -54,3 +54,11 @@ def test_smoke_suite(tmp_path, gpu):
     text = (tmp_path / "report.md").read_text()
     assert text == report(rows) and "## bricks" in text and "product vs plain K=4" in text
     assert (tmp_path / "results.csv").read_text().startswith("heightmap,size,angle,variant")
+
+
+def test_cli_rejects_bad_options(tmp_path, capsys):
+    from wgpuviewer.cli import main
+
+    for argv in (["--angles", "90"], ["--angles", "a"], ["--heightmaps", "nope"], ["--heightmaps", ","]):
+        assert main(["refined-distance", "--out", str(tmp_path), *argv]) == 2
+        assert "Traceback" not in capsys.readouterr().err
