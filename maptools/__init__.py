@@ -21,7 +21,7 @@ from .io import validate_height
 __all__ = ["generate", "validate_height", "resolve_backend", "VERSION", "KINDS"]
 
 #: Version of the map algorithms; part of every cache key (bump when an output changes).
-VERSION = "maptools-2"
+VERSION = "maptools-3"
 
 _notice_printed = False
 
@@ -49,7 +49,8 @@ def generate(kind: str, height, backend: str = "auto", **options):
     """Generate map ``kind`` from ``height`` (float (H, W) in [0, 1]) on ``backend`` (auto, gpu, cpu).
 
     normal -> float32 (H, W, 3); complexity -> uint8 (H, W); maxmip -> list of float32 arrays (level 0 first);
-    distance, distance_refined -> float32 (Dz, H, W) volumes; cone -> float32 (H, W) ratios (docs/maps.md).
+    distance -> float32 (Dz, H, W) volume; distance_refined -> float16 (V, Dz, H, W) volumes; cone -> float32 (H, W)
+    ratios (docs/maps.md).
     """
     from .registry import get_kind
 

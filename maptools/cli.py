@@ -117,7 +117,7 @@ def build_parser() -> argparse.ArgumentParser:
     ben.add_argument("--kinds", default=None, help="comma-separated kinds (default all)")
     ben.add_argument("--sizes", default="64,256,1024", help="square sizes for the 2D kinds")
     ben.add_argument("--volume-sizes", default="32,64,128", help="square sizes for distance (slices 16)")
-    ben.add_argument("--refined-sizes", default="16,32", help="square sizes for distance_refined (slices 8)")
+    ben.add_argument("--refined-sizes", default="32,64", help="square sizes for distance_refined (slices 8)")
     ben.add_argument("--cone-sizes", default="64,128", help="square sizes for cone (max_ratio 16)")
     ben.add_argument("--repeat", type=int, default=3, help="timed runs per cell (best is reported)")
     return parser
@@ -354,7 +354,7 @@ def _sizes(text: str, flag: str) -> list[int]:
 
 #: kind -> (sizes flag attribute, options used by the benchmark)
 BENCH_SETUP = {"distance": ("volume_sizes", {"slices": 16, "height_scale": 0.05}),
-               "distance_refined": ("refined_sizes", {"slices": 8, "height_scale": 0.25, "angle_step": 10.0}),
+               "distance_refined": ("refined_sizes", {"slices": 8, "height_scale": 0.25}),
                "cone": ("cone_sizes", {})}
 
 

@@ -1,39 +1,39 @@
-"""CPU reference for the 3D distance maps (Donnelly) and the visibility-refined distance map (seed 000).
+"""The plain 3D distance map (Donnelly), box-exact on a sub-cell outer solid: CPU reference, and the geometry the
+refined kind (``maptools.refined``) shares with it. docs/maps.md states the contract and the safety argument.
 
-Metric ("texel metric", see docs/maps.md). A W x H height map with height_scale S and Dz slices spans the
-periodic box [0, W) x [0, W) x [0, S*W] of metric space: X = u*W, Y = v*W, Z = t*S*W (t = layer depth).
-One unit = one texel along u; v is scaled by the aspect W/H (the tangent frame is isotropic in UV units), depth
-by S*W. Voxel (i, j, k) has its centre at X = i + 0.5, Y = (j + 0.5) * W/H, Z = (k + 0.5) * S*W/Dz, i.e. above
-the texel centres, and its box is [i, i+1] x [j, j+1]*W/H x [k, k+1]*S*W/Dz.
+Metric ("texel metric"). A W x H height map with height_scale S and Dz slices spans the periodic box
+[0, W) x [0, W) x [0, S*W] of metric space: X = u*W, Y = v*W, Z = t*S*W (t = layer depth, Z grows downwards).
+One unit = one texel along u; a texel row spans sy = W/H units (the tangent frame is isotropic in UV units).
+Voxel (i, j, k) is the box [i, i+1] x [j, j+1]*sy x [k, k+1]*dz, dz = S*W/Dz.
 
-Surface used for the distances: S' = the union over the bilinear cells (between four texel centres) of the
-half-infinite boxes  cell x [min of the four corner depths, inf).  The bilinear solid {t >= D(u, v)} lies inside
-S' (a bilinear patch never goes above its highest corner), so distances to S' are lower bounds of distances to
-the relief: the plain map is exact for S' and conservative for the real surface.
-For a voxel centre (always above a texel centre) the nearest point of a cell box lies on the column above one of
-the cell's corners, so the distance to S' is
+Outer solid O. Each bilinear cell (between four texel centres) is split into K x K sub-cells; sub-cell (a, b)
+covers X in [0.5 + a/K, 0.5 + (a+1)/K] (rows likewise, times sy) and carries the column rect x [T, inf) with
+T = the least depth at its four corners. The bilinear patch restricted to a sub-rectangle is bilinear, so its
+minimum is at a corner: O contains the relief solid {t >= D(u, v)}. K = 1 is the cell-min solid of Donnelly's
+construction; larger K hugs slopes more closely.
 
-    d(i, j, k)^2 = min over texels q of  wrapdx^2 + (W/H)^2 wrapdy^2 + ((E_q - t_k)^+ * S*W)^2,
-    E_q = min of D over the 3x3 texels around q (the cells that touch q),
-
-a separable generalised distance transform computed here exactly (float64, brute force over offsets with an
-exact early exit). The stored value subtracts the half voxel diagonal h (so that a NEAREST lookup anywhere inside
-the voxel's box, or a trilinear lookup, stays a lower bound: the distance is 1-Lipschitz) and a float-rounding
-margin, and clamps at 0.
+Plain value of a voxel = the exact distance from the whole (slightly grown) voxel box to O. A tracer at any point
+p of the box may step that far in any direction: safe for a NEAREST lookup anywhere in the box. (It is not safe
+for a trilinear lookup, which mixes in the values of neighbouring boxes.) The distance is a separable
+generalised distance transform over the sub-cell columns, computed exactly: per axis the gap between the box's
+interval and a sub-cell's interval, per column the vertical gap from the box's bottom down to T.
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
 from wgpuviewer.core.errors import UserError
 
-#: Largest volume (W * H * slices) the 3D kinds generate: 2^23 voxels = 32 MiB of float32 (e.g. 512x512x32).
+#: Largest plain volume (W * H * slices) generated: 2^23 voxels = 32 MiB of float32 (e.g. 512x512x32).
 MAX_VOXELS = 1 << 23
-#: Subtracted from every stored distance (texels): covers float32 rounding of the result and of the GPU arithmetic.
+#: Subtracted from every stored distance (texels): covers float32 rounding of the build and of the tracer's arithmetic.
 STORE_MARGIN = 1e-3
+#: Every voxel box is grown by this much (texels) on each side: a tracer's float32 position a hair outside the box
+#: its nearest lookup picked is still inside the box the value was computed for.
+BOX_GROW = 1e-3
+#: Sub-cell counts per cell side the kinds accept (the GPU's intermediate buffers grow with K).
+SUBCELLS = (1, 2, 4, 8)
 
 
 # -- geometry ---------------------------------------------------------------------------------------
@@ -43,204 +43,125 @@ def spacing(w: int, h: int, slices: int, height_scale: float) -> tuple[float, fl
     return 1.0, w / h, height_scale * w / slices
 
 
-def half_diagonal(w: int, h: int, slices: int, height_scale: float) -> float:
-    """Largest distance from a voxel centre to a point of its box (= half the voxel diagonal)."""
-    sx, sy, sz = spacing(w, h, slices, height_scale)
-    return 0.5 * math.sqrt(sx * sx + sy * sy + sz * sz)
+def check_volume(w: int, h: int, slices: int, kind: str = "distance", volumes: int = 1, limit: int = MAX_VOXELS,
+                 unit: str = "float32") -> None:
+    n = w * h * slices * volumes
+    if n > limit:
+        what = f"{volumes} volumes of {w}x{h}x{slices}" if volumes > 1 else f"a {w}x{h}x{slices} volume"
+        raise UserError(f"{kind}: {what} hold {n} values, more than the limit {limit} ({unit}); "
+                        f"downscale the height map or use fewer --slices")
 
 
-def check_volume(w: int, h: int, slices: int, kind: str = "distance") -> None:
-    n = w * h * slices
-    if n > MAX_VOXELS:
-        raise UserError(f"{kind}: a {w}x{h}x{slices} volume has {n} voxels, more than the limit {MAX_VOXELS} "
-                        f"({MAX_VOXELS * 4 >> 20} MiB of float32); downscale the height map or use fewer --slices")
+def vertex_depth(depth: np.ndarray, k: int) -> np.ndarray:
+    """The bilinear depth (repeat addressing) at the sub-cell vertices X = 0.5 + a/K, Y = (0.5 + b/K) sy:
+    float64 (H*K, W*K), [b, a]."""
+    h, w = depth.shape
+
+    def axis(n):
+        a = np.arange(n * k)
+        return a // k, (a // k + 1) % n, (a % k) / k
+
+    x0, x1, fx = axis(w)
+    y0, y1, fy = axis(h)
+    d = np.asarray(depth, np.float64)
+    r0 = d[y0][:, x0] * (1 - fx) + d[y0][:, x1] * fx
+    r1 = d[y1][:, x0] * (1 - fx) + d[y1][:, x1] * fx
+    return r0 * (1 - fy)[:, None] + r1 * fy[:, None]
 
 
-def neighbourhood(depth: np.ndarray, op) -> np.ndarray:
-    """op (np.minimum / np.maximum) over the 3x3 texels around each texel, with wrap (repeat) addressing."""
-    out = depth.copy()
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            if dx or dy:
-                op(out, np.roll(depth, (dy, dx), axis=(0, 1)), out=out)
+def subcell_tops(depth: np.ndarray, k: int) -> np.ndarray:
+    """Tops T (layer depth t) of the outer solid's sub-cell columns: the least depth at each sub-cell's four
+    corners, float64 (H*K, W*K); sub-cell [b, a] covers X in [0.5 + a/K, 0.5 + (a+1)/K] (rows likewise)."""
+    v = vertex_depth(depth, k)
+    out = v.copy()
+    for shift in ((0, 1), (1, 0), (1, 1)):
+        np.minimum(out, np.roll(v, (-shift[0], -shift[1]), axis=(0, 1)), out=out)
     return out
 
 
-def layer_depths(slices: int) -> np.ndarray:
-    """t at the voxel centres: (k + 0.5) / Dz."""
-    return (np.arange(slices, dtype=np.float64) + 0.5) / slices
+def cell_tops(depth: np.ndarray) -> np.ndarray:
+    """Top of each whole bilinear cell [i + 0.5, i + 1.5] x [j + 0.5, j + 1.5] (texels): the least of its four corner
+    depths, float64 (H, W) at [j, i]. Equals the minimum over the cell's sub-cell tops for every K."""
+    d = np.asarray(depth, np.float64)
+    right = np.roll(d, -1, axis=1)
+    return np.minimum(np.minimum(d, right), np.minimum(np.roll(d, -1, axis=0), np.roll(right, -1, axis=0)))
 
 
-def _gdt_axis(f: np.ndarray, axis: int, weight2: float) -> np.ndarray:
-    """out[i] = min over q of (periodic |q - i|)^2 * weight2 + f[q] along ``axis``; exact."""
-    n = f.shape[axis]
-    out = f.copy()
-    for a in range(1, n // 2 + 1):
-        c = a * a * weight2
-        if c >= out.max():  # no candidate at this or a larger offset can beat any current value
+def interval_gap(lo, hi, half):
+    """Distance from 0 to the interval [lo - half, hi + half] (the interval grown by a box's half-extent)."""
+    return np.maximum(0.0, np.maximum(lo - half, -(hi + half)))
+
+
+def subcell_gap(o, k: int, step: float):
+    """Gap along one axis between a voxel box (half-extent step/2 + BOX_GROW) and the sub-cell K*n + o of its own
+    index n: relative to the voxel centre that sub-cell covers [o/K, (o+1)/K] * step."""
+    o = np.asarray(o, np.float64)
+    return interval_gap(o / k * step, (o + 1) / k * step, 0.5 * step + BOX_GROW)
+
+
+def box_bottoms(slices: int, height_scale: float, w: int) -> np.ndarray:
+    """Z of the bottom face of each slice's (grown) voxel box."""
+    dz = height_scale * w / slices
+    return (np.arange(slices, dtype=np.float64) + 1.0) * dz + BOX_GROW
+
+
+# -- the plain map ----------------------------------------------------------------------------------
+
+def _gdt_axis(f: np.ndarray, k: int, n: int, step: float) -> np.ndarray:
+    """out[..., i] = min over offsets o of subcell_gap(o)^2 + f[..., (K i + o) mod (n K)] along the last axis
+    (length n K in, n out): exact. Offsets are taken in pairs (o, -1 - o) of equal gap, outwards, and stop once the
+    gap alone reaches every current value."""
+    nk = f.shape[-1]
+    base = k * np.arange(n)
+    out = np.full(f.shape[:-1] + (n,), np.inf)
+    for o in range(nk // 2 + 1):
+        g2 = float(subcell_gap(o, k, step)) ** 2
+        if g2 >= out.max():
             break
-        cand = np.minimum(np.roll(f, a, axis=axis), np.roll(f, -a, axis=axis))
-        cand += c
-        np.minimum(out, cand, out=out)
+        for off in (o, -1 - o):
+            np.minimum(out, f[..., (base + off) % nk] + g2, out=out)
     return out
 
 
-def column_edt(tops: np.ndarray, slices: int, height_scale: float, solid_below: bool = True) -> np.ndarray:
-    """Exact distance (float64, (Dz, H, W)) from every voxel centre to the union of vertical columns at the texel
-    centres: column q occupies t >= tops[q] (solid_below) or t <= tops[q] (free space), unbounded in t."""
-    h, w = tops.shape
-    t = layer_depths(slices)[:, None, None]
-    gap = (tops[None] - t) if solid_below else (t - tops[None])
-    f = (np.maximum(gap, 0.0) * (height_scale * w)) ** 2
-    f = _gdt_axis(f, 2, 1.0)
-    f = _gdt_axis(f, 1, (w / h) ** 2)
-    return np.sqrt(f)
+def box_distance(depth: np.ndarray, slices: int, height_scale: float, k: int) -> np.ndarray:
+    """Exact distance (float64, (Dz, H, W)) from every grown voxel box to the outer solid of K x K sub-cells."""
+    h, w = depth.shape
+    sw = height_scale * w
+    tops = subcell_tops(depth, k) * sw
+    out = np.empty((slices, h, w))
+    for z, bottom in enumerate(box_bottoms(slices, height_scale, w)):
+        f = np.maximum(tops - bottom, 0.0) ** 2        # (H K, W K): vertical gap of each sub-cell column
+        f = _gdt_axis(f, k, w, 1.0)                   # (H K, W): + the gap along u
+        f = _gdt_axis(f.T, k, h, w / h).T             # (H, W): + the gap along v
+        out[z] = np.sqrt(f)
+    return out
 
 
-def solid_distance(depth: np.ndarray, slices: int, height_scale: float) -> np.ndarray:
-    """Exact distance from each voxel centre to S' (the cell-min superset of the bilinear solid)."""
-    return column_edt(neighbourhood(depth, np.minimum), slices, height_scale, True)
+def store(d: np.ndarray) -> np.ndarray:
+    """Stored (safe) value: max(0, d - STORE_MARGIN), float32 rounded towards 0 (never above d - margin)."""
+    v = np.maximum(np.asarray(d, np.float64) - STORE_MARGIN, 0.0)
+    return round_down(v, np.float32)
 
 
-def free_distance(depth: np.ndarray, slices: int, height_scale: float) -> np.ndarray:
-    """Exact distance from each voxel centre to F' = cells x (-inf, max corner depth]: a superset of the free
-    space {t < D} above the bilinear surface, so this is a lower bound of the depth inside the relief."""
-    return column_edt(neighbourhood(depth, np.maximum), slices, height_scale, False)
+def round_down(v: np.ndarray, dtype) -> np.ndarray:
+    """Non-negative float64 values as ``dtype`` (float32 / float16), each rounded down (never above the input)."""
+    out = v.astype(dtype)
+    over = out.astype(np.float64) > v
+    out[over] = np.nextafter(out[over], dtype(0))
+    return out
 
 
-def store(d: np.ndarray, w: int, h: int, slices: int, height_scale: float) -> np.ndarray:
-    """Stored (safe) value: max(0, d - half voxel diagonal - STORE_MARGIN), float32."""
-    hd = half_diagonal(w, h, slices, height_scale)
-    return np.maximum(d - (hd + STORE_MARGIN), 0.0).astype(np.float32)
+def check_subcells(k: int, kind: str) -> None:
+    if k not in SUBCELLS:
+        raise UserError(f"{kind}: option subcells={k}; expected one of {', '.join(map(str, SUBCELLS))}")
 
 
-def distance(height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05) -> np.ndarray:
-    """Distance volume, float32 (Dz, H, W): safe sphere-tracing radius per voxel in texel-metric units."""
+def distance(height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05, subcells: int = 4) -> np.ndarray:
+    """Distance volume, float32 (Dz, H, W): per voxel a safe step (texel metric) for a nearest lookup anywhere in
+    the voxel, in any direction: the distance from the voxel box to the outer solid of ``subcells``^2 sub-cells."""
     hh, w = height.shape
     check_volume(w, hh, slices)
+    check_subcells(subcells, "distance")
     depth = 1.0 - height.astype(np.float64)
-    return store(solid_distance(depth, slices, height_scale), w, hh, slices, height_scale)
+    return store(box_distance(depth, slices, height_scale, subcells))
 
-
-# -- refined map ------------------------------------------------------------------------------------
-
-#: Forward (free path) march: at most this many sphere steps per voxel and direction.
-REFINE_FORWARD_STEPS = 48
-#: Backward (visibility) test: at most this many samples per voxel and direction.
-REFINE_BACKWARD_SAMPLES = 24
-
-
-def cone_directions(max_angle: float, angle_step: float) -> tuple[np.ndarray, float]:
-    """Unit directions (N, 3) covering the cone of half-angle ``max_angle`` (degrees) around +Z (downwards into
-    the relief), and alpha (radians): every direction of the cone is within alpha of one of them.
-
-    Rings at theta_i = i * delta (i = 0..n, delta = max_angle / n <= angle_step), ring i with
-    m_i = ceil(2 pi sin theta_i / delta) azimuths. A direction at (theta, phi) is within delta/2 (along the
-    meridian) of the nearest ring and within sin(theta_r) * pi / m_r <= delta/2 (along that ring) of a sample, so
-    by the triangle inequality alpha = delta.
-    """
-    n = max(1, math.ceil(max_angle / angle_step - 1e-9))
-    delta = math.radians(max_angle) / n
-    dirs = []
-    for i in range(n + 1):
-        th = i * delta
-        m = 1 if i == 0 else max(1, math.ceil(2 * math.pi * math.sin(th) / delta))
-        for j in range(m):
-            ph = 2 * math.pi * (j + 0.5 * (i % 2)) / m
-            dirs.append((math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th)))
-    return np.array(dirs, np.float64), delta
-
-
-class _Field:
-    """Nearest-voxel lower bound of a 1-Lipschitz distance given at voxel centres (float64 CPU twin of the WGSL)."""
-
-    def __init__(self, vol: np.ndarray, sp: tuple[float, float, float]):
-        self.flat = vol.ravel()
-        self.dz, self.h, self.w = vol.shape
-        self.sp = sp
-
-    def lower(self, x, y, z):
-        sx, sy, sz = self.sp
-        fi, fj = np.floor(x / sx), np.floor(y / sy)
-        fk = np.clip(np.floor(z / sz), 0, self.dz - 1)
-        off = np.sqrt((x - (fi + 0.5) * sx) ** 2 + (y - (fj + 0.5) * sy) ** 2 + (z - (fk + 0.5) * sz) ** 2)
-        i = np.mod(fi, self.w).astype(np.int64)
-        j = np.mod(fj, self.h).astype(np.int64)
-        idx = (fk.astype(np.int64) * self.h + j) * self.w + i
-        return self.flat[idx] - off
-
-
-def refine(dsolid: np.ndarray, dfree: np.ndarray, w: int, h: int, slices: int, height_scale: float,
-           max_angle: float, angle_step: float) -> np.ndarray:
-    """Refined distances (float64, before `store`'s margin), from the exact S' and F' distance volumes.
-
-    For voxel centre c and sampled direction s (unit, within the cone): eps = half voxel diagonal,
-    alpha = covering angle of the direction set. A real ray (p, w) with |p - c| <= eps and angle(w, s) <= alpha
-    stays within eps + L*alpha of the sampled ray c + L s after a length L. So
-      * free path: l_s = first L with  dS'(c + L s) <= eps + L alpha  (found by safe steps of the (1+alpha)-
-        Lipschitz function g(L) = lowerbound_dS'(c + L s) - eps - L alpha, stopped early when g <= 0 or after
-        REFINE_FORWARD_STEPS: stopping early only shortens l_s), is <= the real ray's free path;
-      * visibility: (c, s) counts as occluded only if a sample c - L s (L > 0, t >= 0) has
-        lowerbound_dF'(.) > eps + L alpha, i.e. every nearby real ray certainly passes through the relief.
-        Skipping samples only declares more directions admissible (smaller minimum): safe.
-    Result (a safe nearest-lookup value, before the rounding margin): max(euclid - eps, min over admissible s of
-    l_s); voxels with no admissible direction keep euclid - eps (both terms are lower bounds of the real free path).
-    """
-    dirs, alpha = cone_directions(max_angle, angle_step)
-    sp = spacing(w, h, slices, height_scale)
-    eps = half_diagonal(w, h, slices, height_scale)
-    fs, ff = _Field(dsolid, sp), _Field(dfree, sp)
-    zc, yc, xc = np.meshgrid((np.arange(slices) + 0.5) * sp[2], (np.arange(h) + 0.5) * sp[1],
-                             (np.arange(w) + 0.5) * sp[0], indexing="ij")
-    euclid = dsolid.ravel()
-    best = np.full(euclid.shape, np.inf)
-    active = np.flatnonzero(euclid > eps)  # elsewhere every l_s = 0: the stored value is 0 either way
-    x0, y0, z0 = xc.ravel()[active], yc.ravel()[active], zc.ravel()[active]
-    bstep_min = 0.5 * min(sp)
-    for s in dirs:
-        b = best[active]
-        # forward: free path along s
-        L = np.zeros(active.size)
-        run = np.ones(active.size, bool)
-        for _ in range(REFINE_FORWARD_STEPS):
-            idx = np.flatnonzero(run)
-            if not idx.size:
-                break
-            Li = L[idx]
-            g = fs.lower(x0[idx] + Li * s[0], y0[idx] + Li * s[1], z0[idx] + Li * s[2]) - eps - Li * alpha
-            stop = (g <= 0) | (Li >= b[idx])
-            run[idx[stop]] = False
-            go = idx[~stop]
-            L[go] += g[~stop] / (1.0 + alpha)
-        cand = np.flatnonzero(b > L)
-        if not cand.size:
-            continue
-        # backward: is (c, s) certainly occluded?
-        lend = z0[cand] / s[2]  # length back to the top plane t = 0
-        bstep = np.maximum(lend / REFINE_BACKWARD_SAMPLES, bstep_min)
-        occluded = np.zeros(cand.size, bool)
-        for q in range(1, REFINE_BACKWARD_SAMPLES + 1):
-            Lb = q * bstep
-            ok = (Lb <= lend) & ~occluded
-            if not ok.any():
-                break
-            k = cand[ok]
-            Lk = Lb[ok]
-            inside = ff.lower(x0[k] - Lk * s[0], y0[k] - Lk * s[1], z0[k] - Lk * s[2]) > eps + Lk * alpha
-            occluded[np.flatnonzero(ok)[inside]] = True
-        keep = cand[~occluded]
-        best[active[keep]] = np.minimum(best[active[keep]], L[keep])
-    out = np.where(np.isfinite(best), np.maximum(euclid - eps, best), euclid - eps)
-    return out.reshape(dsolid.shape)
-
-
-def distance_refined(height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05, max_angle: float = 80.0,
-                     angle_step: float = 6.0) -> np.ndarray:
-    """Visibility-refined distance volume, float32 (Dz, H, W), same metric and lookup rule as `distance`."""
-    hh, w = height.shape
-    check_volume(w, hh, slices, "distance_refined")
-    depth = 1.0 - height.astype(np.float64)
-    ds = solid_distance(depth, slices, height_scale)
-    df = free_distance(depth, slices, height_scale)
-    r = refine(ds, df, w, hh, slices, height_scale, max_angle, angle_step)
-    return np.maximum(r - STORE_MARGIN, 0.0).astype(np.float32)

@@ -26,8 +26,6 @@ class GpuKernelError(UserError):
     """A kernel failed to compile, validate or run on this adapter."""
 
 
-
-
 class MapGpu:
     """Pipelines (compiled on first use) for one device."""
 
@@ -203,77 +201,99 @@ def _dispatch3(g: MapGpu, encoder, file: str, entry: str, bindings: dict, w: int
     cp.end()
 
 
-def _check_volume(g: MapGpu, w: int, h: int, slices: int) -> None:
+def _check_volume(g: MapGpu, w: int, h: int, slices: int, subcells: int, volumes: int = 1) -> None:
     g.check_size(h, w)
-    need = w * h * slices * 4
+    need = w * h * slices * 4 * volumes
+    rows = w * h * subcells * slices * 4  # the plain map's row pass keeps every sub-cell row
     limits = g.device.limits
     cap = min(limits["max-storage-buffer-binding-size"], limits["max-buffer-size"])
-    if need > cap or slices > limits["max-compute-workgroups-per-dimension"]:
-        raise UserError(f"a {w}x{h}x{slices} volume ({need} bytes) exceeds this adapter's limits; "
-                        f"use fewer --slices or --backend cpu")
+    if max(need, rows) > cap or slices > limits["max-compute-workgroups-per-dimension"]:
+        raise UserError(f"a {w}x{h}x{slices} volume with {subcells}x{subcells} sub-cells needs a {max(need, rows)}-byte "
+                        f"buffer, more than this adapter's {cap}; use fewer --slices or --subcells, or --backend cpu")
 
 
-def _distance_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale: float, free: bool,
-                     stored: bool, label: str):
-    """Encode tops + pass_x + pass_y; returns the output volume buffer."""
+def _plain_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale: float, subcells: int, label: str):
+    """Encode tops + pass_x + pass_y of distance.wgsl; returns (stored plain volume, sub-cell tops, params)."""
     from . import distance as dist
 
-    subtract = dist.half_diagonal(w, h, slices, height_scale) + dist.STORE_MARGIN
-    mode = 1 if free else 0
-    tops = g.storage(w * h * 4, f"maptools {label} tops")
-    g1 = g.storage(w * h * slices * 4, f"maptools {label} row pass")
+    k = subcells
+    params = g.uniform([w, h, slices, k, float(height_scale * w), float(w / h), float(height_scale * w / slices),
+                        float(dist.BOX_GROW), float(dist.STORE_MARGIN)], f"maptools {label} params")
+    tops = g.storage(w * h * k * k * 4, f"maptools {label} sub-cell tops")
+    rows = g.storage(w * h * k * slices * 4, f"maptools {label} row pass")
     out = g.storage(w * h * slices * 4, f"maptools {label} volume")
-    common = [w, h, slices]
-    p_tops = g.uniform(common + [mode, float(height_scale * w), float((w / h) ** 2), 0.0, 0.0],
-                       f"maptools {label} tops params")
-    p_y = g.uniform(common + [1 if stored else 0, float(height_scale * w), float((w / h) ** 2), float(subtract), 0.0],
-                    f"maptools {label} column params")
-    _dispatch3(g, enc, "distance.wgsl", "tops", {0: p_tops, 1: src, 2: tops}, w, h, 1)
-    _dispatch3(g, enc, "distance.wgsl", "pass_x", {0: p_tops, 1: tops, 2: g1}, w, h, slices)
-    _dispatch3(g, enc, "distance.wgsl", "pass_y", {0: p_y, 1: g1, 2: out}, w, h, slices)
-    return out
+    _dispatch3(g, enc, "distance.wgsl", "tops", {0: params, 1: src, 2: tops}, w * k, h * k, 1)
+    _dispatch3(g, enc, "distance.wgsl", "pass_x", {0: params, 1: tops, 2: rows}, w, h * k, slices)
+    _dispatch3(g, enc, "distance.wgsl", "pass_y", {0: params, 1: rows, 2: out}, w, h, slices)
+    return out, tops, params
 
 
 @_guard
-def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05):
+def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05, subcells: int = 4):
     """GPU twin of distance.distance (distance.wgsl)."""
     from . import distance as dist
 
     h, w = height.shape
     dist.check_volume(w, h, slices)
-    _check_volume(g, w, h, slices)
+    dist.check_subcells(subcells, "distance")
+    _check_volume(g, w, h, slices, subcells)
     src = g.storage(height, "maptools distance src")
     enc = g.encoder("maptools distance")
-    out = _distance_volume(g, enc, src, w, h, slices, height_scale, False, True, "distance")
+    out, _, _ = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance")
     g.submit(enc, "distance")
     return g.read(out, w * h * slices).reshape(slices, h, w)
 
 
 @_guard
 def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05,
-                     max_angle: float = 80.0, angle_step: float = 6.0):
-    """GPU twin of distance.distance_refined (distance.wgsl raw volumes, then distance_refined.wgsl)."""
+                     subcells: int = 4, max_angle: float = 80.0, sectors: int = 4, bands: int = 8,
+                     reach: float = 16.0, progress: bool = True):
+    """GPU twin of refined.distance_refined: the plain volume (distance.wgsl), then one dispatch of
+    distance_refined.wgsl per direction bin, each read back and rounded down to float16."""
+    from tqdm import tqdm
+
     from . import distance as dist
+    from . import refined as rf
 
     h, w = height.shape
-    dist.check_volume(w, h, slices, "distance_refined")
-    _check_volume(g, w, h, slices)
-    dirs, alpha = dist.cone_directions(max_angle, angle_step)
-    d4 = np.zeros((len(dirs), 4), np.float32)
-    d4[:, :3] = dirs
+    rf.check(w, h, slices, sectors, bands)
+    dist.check_subcells(subcells, "distance_refined")
+    _check_volume(g, w, h, slices, subcells, min(bands, rf.BANDS_PER_PASS))
     src = g.storage(height, "maptools distance_refined src")
-    enc = g.encoder("maptools distance_refined")
-    ds = _distance_volume(g, enc, src, w, h, slices, height_scale, False, False, "distance_refined solid")
-    df = _distance_volume(g, enc, src, w, h, slices, height_scale, True, False, "distance_refined free")
-    dirbuf = g.storage(d4, "maptools distance_refined directions")
-    out = g.storage(w * h * slices * 4, "maptools distance_refined volume")
-    sx, sy, sz = dist.spacing(w, h, slices, height_scale)
-    params = g.uniform([w, h, slices, len(dirs), float(sx), float(sy), float(sz),
-                        float(dist.half_diagonal(w, h, slices, height_scale)), float(alpha),
-                        float(dist.STORE_MARGIN), 0.0, 0.0], "maptools distance_refined params")
-    _dispatch3(g, enc, "distance_refined.wgsl", "main", {0: params, 1: ds, 2: df, 3: dirbuf, 4: out}, w, h, slices)
-    g.submit(enc, "distance_refined")
-    return g.read(out, w * h * slices).reshape(slices, h, w)
+    enc = g.encoder("maptools distance_refined plain")
+    plain, sub_tops, _ = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance_refined")
+    g.submit(enc, "distance_refined plain")
+    directions = rf.bins(sectors, bands, max_angle)
+    nbands = bands
+    lists = [rf.entries(directions[s], subcells, w / h, reach) for s in range(sectors)]  # band independent
+    levels = max(e.levels for e in lists)
+    n = w * h * slices
+    out = np.empty((len(directions) + 1, slices, h, w), np.float16)
+    lanes = min(nbands, rf.BANDS_PER_PASS)
+    vol = g.storage(lanes * n * 4, "maptools distance_refined band volumes")
+    windows = g.storage(levels * w * h * 4, "maptools distance_refined window tops")
+    passes = [(s, b0) for s in range(sectors) for b0 in range(0, nbands, rf.BANDS_PER_PASS)]
+    for number, (sector, b0) in enumerate(tqdm(passes, desc="distance_refined (gpu)", unit="pass",
+                                               disable=None if progress else True, leave=False)):
+        group = [directions[b * sectors + sector] for b in range(b0, min(b0 + rf.BANDS_PER_PASS, nbands))]
+        lane = [0.0] * (4 - len(group))
+        p = g.uniform([w, h, slices, subcells, len(lists[sector].rho), levels, len(group), 0,
+                       *[float(d.tan_lo) for d in group], *lane, *[float(d.cot_hi) for d in group], *lane,
+                       *[float(1.0 / d.sin_hi) for d in group], *lane, *[float(reach / d.sin_hi) for d in group],
+                       *lane, float(height_scale * w / slices), float(dist.BOX_GROW), float(dist.STORE_MARGIN),
+                       float(height_scale * w)], "maptools distance_refined pass params")
+        cbuf = g.storage(lists[sector].packed(w, h, subcells), "maptools distance_refined columns")
+        enc = g.encoder("maptools distance_refined pass")
+        if number == 0:
+            _dispatch3(g, enc, "distance_refined.wgsl", "window_tops", {0: p, 1: src, 2: windows}, w, h, levels)
+        _dispatch3(g, enc, "distance_refined.wgsl", "main",
+                   {0: p, 1: plain, 2: vol, 3: sub_tops, 4: windows, 5: cbuf}, w, h, slices)
+        g.submit(enc, "distance_refined pass")
+        result = dist.round_down(g.read(vol, len(group) * n).astype(np.float64), np.float16)
+        for i, b in enumerate(range(b0, b0 + len(group))):
+            out[b * sectors + sector] = result[i * n:(i + 1) * n].reshape(slices, h, w)
+    out[-1] = dist.round_down(g.read(plain, n).astype(np.float64), np.float16).reshape(slices, h, w)
+    return out
 
 
 @_guard

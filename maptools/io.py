@@ -81,8 +81,10 @@ def write_maxmip(f, levels: list, ext: str, bits: int = 8) -> None:
 
 
 def write_volume(f, vol, ext: str, bits: int = 8) -> None:
-    """.npy: float32 (Dz, H, W) volume (slice k = layer depth t in [k/Dz, (k+1)/Dz])."""
-    np.save(f, np.asarray(vol, np.float32))
+    """.npy: the volume as generated: float32 (Dz, H, W) (distance) or float16 (V, Dz, H, W) (distance_refined);
+    slice k = layer depth t in [k/Dz, (k+1)/Dz]."""
+    a = np.asarray(vol)
+    np.save(f, a if a.dtype == np.float16 else a.astype(np.float32))
 
 
 def write_result(kind, result, path, bits: int = 8) -> Path:

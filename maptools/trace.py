@@ -24,18 +24,23 @@ def _rays(uv0, view_dir, who: str) -> tuple[np.ndarray, np.ndarray, int]:
 
 
 def sphere_trace(vol: np.ndarray, uv0, view_dir, height_scale: float, *, stop: float = 1e-3,
-                 max_steps: int = 256) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                 max_steps: int = 256, which=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Trace rays entering at ``uv0`` (N, 2) with tangent-space view vectors ``view_dir`` (N, 3), V.z > 0, through
-    the distance volume ``vol`` (Dz, H, W). Returns (t at the stop point, steps taken, capped flag)."""
-    dz, h, w = vol.shape
+    the distance volume ``vol`` (Dz, H, W), or through volume ``which[n]`` of a (V, Dz, H, W) stack (the refined
+    kind; ``maptools.refined.volume_index`` picks a ray's volume). Returns (t at the stop point, steps taken,
+    capped flag)."""
+    vol = np.asarray(vol, np.float64)
+    vol = vol[None] if vol.ndim == 3 else vol
+    _, dz, h, w = vol.shape
     uv0, v, n = _rays(uv0, view_dir, "sphere_trace")
+    which = np.zeros(n, np.int64) if which is None else np.broadcast_to(np.asarray(which, np.int64), (n,))
     sw = height_scale * w
     norm = np.linalg.norm(v, axis=1)
     wx, wy, wz = -v[:, 0] / norm, -v[:, 1] / norm, v[:, 2] / norm  # unit direction, metric space, Z down
     x, y, z = uv0[:, 0] * w, uv0[:, 1] * w, np.zeros(n)
     steps = np.zeros(n, np.int64)
     done = np.zeros(n, bool)
-    flat = np.asarray(vol, np.float64).ravel()
+    flat = vol.ravel()
     for _ in range(max_steps):
         run = np.flatnonzero(~done)
         if not run.size:
@@ -44,7 +49,7 @@ def sphere_trace(vol: np.ndarray, uv0, view_dir, height_scale: float, *, stop: f
         i = np.mod(np.floor(x[run]), w).astype(np.int64)
         j = np.mod(np.floor(y[run] * h / w), h).astype(np.int64)
         k = np.clip(np.floor(t * dz), 0, dz - 1).astype(np.int64)
-        m = flat[(k * h + j) * w + i]
+        m = flat[((which[run] * dz + k) * h + j) * w + i]
         steps[run] += 1
         fin = (m < stop) | (t >= 1.0)
         done[run[fin]] = True

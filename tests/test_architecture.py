@@ -80,8 +80,10 @@ def allowed(src: str, dst: str) -> bool:
         return b in ("core", "maptools") or dst in SCENE_MODULES
     if a == "viewer":
         return base
-    if a == "bench" or a.startswith("studies."):
+    if a == "bench":
         return base or b == "maptools"
+    if a.startswith("studies."):  # a study may measure on the benchmark's views; never another study
+        return base or b in ("maptools", "bench")
     return True  # cli, __main__ and the documented re-exports
 
 

@@ -159,17 +159,8 @@ def cmd_filters(args) -> int:
     return 0
 
 
-def _names(text, option):
-    if text is None:
-        return None
-    items = [x.strip() for x in text.split(",") if x.strip()]
-    if not items:
-        raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
-    return items
-
-
 def _numbers(text, option, example):
-    items = _names(text, option)
+    items = names(text, option)
     if items is None:
         return None
     try:
@@ -187,9 +178,9 @@ def cmd_filtering(args) -> int:
         size = parse_size(args.size)
     command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["filtering"] else "wgpuviewer filtering"
     options = resolve_options(
-        args.suite, size=size, frames=args.frames, reliefs=_names(args.reliefs, "--reliefs"),
-        albedos=_names(args.albedos, "--albedos"), angles=_numbers(args.angles, "--angles", "0,45,80"),
-        footprints=_numbers(args.footprints, "--footprints", "1,4"), filters=_names(args.filters, "--filters"),
+        args.suite, size=size, frames=args.frames, reliefs=names(args.reliefs, "--reliefs"),
+        albedos=names(args.albedos, "--albedos"), angles=_numbers(args.angles, "--angles", "0,45,80"),
+        footprints=_numbers(args.footprints, "--footprints", "1,4"), filters=names(args.filters, "--filters"),
         backend=args.backend, command=command,
     )
     run(options, Path(args.out), progress=not args.quiet)
@@ -226,16 +217,31 @@ def cmd_accuracy(args) -> int:
     return 0
 
 
+def names(text: str | None, option: str) -> list[str] | None:
+    """A comma-separated option value as a list (None when the option was not given)."""
+    if text is None:
+        return None
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    if not items:
+        raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
+    return items
+
+
+def angle_list(text: str | None) -> list[float] | None:
+    """--angles as degrees (None when not given)."""
+    if text is None:
+        return None
+    try:
+        return [float(x) for x in names(text, "--angles")]
+    except ValueError:
+        raise UserError(f"--angles {text!r}: expected comma-separated degrees, e.g. 0,45,80") from None
+
+
 def cmd_bench(args) -> int:
     from wgpuviewer.bench.run import resolve_options, run
 
-    names = _names
-    angles = None
-    if args.angles:
-        try:
-            angles = [float(x) for x in names(args.angles, "--angles")]
-        except ValueError:
-            raise UserError(f"--angles {args.angles!r}: expected comma-separated degrees, e.g. 0,45,80") from None
+    angles = angle_list(args.angles)
+
     def size(text, option):
         if not text:
             return None
@@ -273,6 +279,19 @@ def cmd_perspective(args) -> int:
     return 0
 
 
+def cmd_refined_distance(args) -> int:
+    from wgpuviewer.studies.refined_distance.run import run
+
+    angles = angle_list(args.angles)
+    if angles is not None and not all(0.0 <= a <= 85.0 for a in angles):
+        raise UserError(f"--angles {args.angles!r}: expected degrees from 0 to 85")
+    heightmaps = names(args.heightmaps, "--heightmaps")
+    out = output_dir(args.out, "--out")
+    run(args.suite, out, heightmaps=heightmaps, angles=angles, progress=not args.quiet)
+    print(out / "report.md")
+    return 0
+
+
 def cmd_info(args) -> int:
     from wgpuviewer.core.gpu import describe_adapters
 
@@ -289,8 +308,6 @@ def add_filter_options(parser) -> None:
     parser.add_argument("--derivatives", default=DEFAULT_DERIVATIVES,
                         help=f"derivative source the filter's footprint comes from: uv, displaced, analytic "
                         f"(default {DEFAULT_DERIVATIVES})")
-
-
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -384,13 +401,24 @@ def build_parser() -> argparse.ArgumentParser:
     filtering.add_argument("--quiet", action="store_true", help="no progress bar")
     filtering.set_defaults(func=cmd_filtering)
 
+    refined = sub.add_parser("refined-distance", help="fetches of the distance tracer on every distance-map "
+                             "variant, on the benchmark's views (results.csv, report.md)")
+    refined.add_argument("--out", required=True, help="output folder (results.csv, report.md)")
+    refined.add_argument("--suite", choices=("smoke", "full"), default="full",
+                         help="smoke: two small maps, two angles; full: the benchmark's real maps and wall, 0-80 degrees")
+    refined.add_argument("--heightmaps", help="comma-separated: builtins and/or scikit-image brick,grass,gravel")
+    refined.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 85)")
+    refined.add_argument("--quiet", action="store_true", help="no progress bar")
+    refined.set_defaults(func=cmd_refined_distance)
+
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
     info.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     info.set_defaults(func=cmd_info)
     return parser
 
 
-COMMANDS = ("view", "render", "techniques", "filters", "accuracy", "bench", "filtering", "perspective", "info")
+COMMANDS = ("view", "render", "techniques", "filters", "accuracy", "bench", "filtering", "perspective",
+            "refined-distance", "info")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,10 +1,11 @@
-"""3D distance maps: exactness of the EDT, conservativeness against the float64 exact hit (no ray may tunnel),
-GPU vs CPU, refined >= plain, options, CLI."""
+"""3D distance maps: the plain map is the exact box distance to the sub-cell outer solid, and that solid contains the
+bilinear one; the refined map's columns, bins and per-ray choice are what docs/maps.md says; no ray ever passes the
+float64 exact hit with either map (random and adversarial rays, real and hard-case maps); GPU vs CPU; options; CLI."""
 
 from __future__ import annotations
 
 import itertools
-import logging
+import math
 
 import numpy as np
 import pytest
@@ -12,11 +13,12 @@ import pytest
 import maptools
 from maptools import cli
 from maptools import distance as dist
+from maptools import refined as rf
 from maptools.registry import KINDS
 from maptools.trace import sphere_trace
 from tests.maptools.helpers import adversarial_maps, smooth_tileable
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.relief.reference import exact_hit, view_dir_from_angles
+from wgpuviewer.relief.reference import exact_hit, sample_bilinear, view_dir_from_angles
 
 RNG = np.random.default_rng(1234)
 
@@ -41,74 +43,71 @@ def relief_maps() -> dict[str, np.ndarray]:
 MAPS = relief_maps()
 
 
-@pytest.fixture
-def no_wgpu_errors(caplog):
-    caplog.set_level(logging.WARNING, logger="wgpu")
-    yield
-    errors = [r.getMessage() for r in caplog.records if r.name.startswith("wgpu") and r.levelno >= logging.ERROR]
-    assert not errors, errors
+# -- the plain map: exact box distance to the outer solid ----------------------------------------------
 
-
-# -- the EDT is exact for the surface it defines -------------------------------------------------------
-
-def brute_column_edt(tops, slices, s, solid_below=True):
-    h, w = tops.shape
-    t = dist.layer_depths(slices)
+def brute_box_distance(depth, slices, s, k):
+    """Distance from every grown voxel box to every sub-cell column, over the 3x3 nearest periodic images."""
+    h, w = depth.shape
+    sw, sy, dz, g = s * w, w / h, s * w / slices, dist.BOX_GROW
+    tops = dist.subcell_tops(depth, k) * sw
+    b, a = np.mgrid[0:h * k, 0:w * k]
+    x0, y0 = 0.5 + a / k, (0.5 + b / k) * sy
     out = np.empty((slices, h, w))
-    for k, j, i in itertools.product(range(slices), range(h), range(w)):
+    for z, j, i in itertools.product(range(slices), range(h), range(w)):
         best = np.inf
-        for qj, qi in itertools.product(range(h), range(w)):
-            dx = min(abs(qi - i), w - abs(qi - i))
-            dy = min(abs(qj - j), h - abs(qj - j)) * w / h
-            gap = tops[qj, qi] - t[k] if solid_below else t[k] - tops[qj, qi]
-            best = min(best, dx * dx + dy * dy + (max(gap, 0.0) * s * w) ** 2)
-        out[k, j, i] = np.sqrt(best)
+        for px, py in itertools.product((-w, 0, w), (-w, 0, w)):  # the v period is W in the metric too
+            gx = np.maximum(0, np.maximum(x0 + px - (i + 1 + g), (i - g) - (x0 + px + 1 / k)))
+            gy = np.maximum(0, np.maximum(y0 + py - ((j + 1) * sy + g), (j * sy - g) - (y0 + py + sy / k)))
+            gz = np.maximum(0, tops - ((z + 1) * dz + g))
+            best = min(best, float(np.sqrt(gx ** 2 + gy ** 2 + gz ** 2).min()))
+        out[z, j, i] = best
     return out
 
 
-@pytest.mark.parametrize("shape,slices,s", [((7, 5), 4, 0.5), ((4, 9), 3, 0.2), ((1, 1), 2, 0.1), ((6, 6), 5, 1.0)])
-def test_column_edt_is_exact(shape, slices, s):
-    tops = RNG.random(shape)
-    for below in (True, False):
-        assert np.allclose(dist.column_edt(tops, slices, s, below), brute_column_edt(tops, slices, s, below),
-                           rtol=0, atol=1e-12)
+@pytest.mark.parametrize("shape,slices,s,k", [((7, 5), 4, 0.5, 4), ((7, 5), 3, 0.3, 1), ((4, 9), 3, 0.2, 2),
+                                              ((1, 1), 2, 0.1, 4), ((6, 6), 5, 1.0, 8)])
+def test_plain_map_is_the_exact_box_distance(shape, slices, s, k):
+    depth = RNG.random(shape)
+    got = dist.box_distance(depth, slices, s, k)
+    assert np.allclose(got, brute_box_distance(depth, slices, s, k), rtol=0, atol=1e-12)
 
 
-def test_neighbourhood_wraps():
-    d = np.zeros((5, 6))
-    d[0, 0] = 1.0
-    mx = dist.neighbourhood(d, np.maximum)
-    assert mx[4, 5] == 1 and mx[1, 1] == 1 and mx[2, 2] == 0 and mx.sum() == 9
-
-
-def solid_samples(depth, n, rng):
-    """Random points of the bilinear solid {t >= D(u, v)} in texel-metric coordinates (X, Y, t)."""
-    from wgpuviewer.relief.reference import sample_bilinear
-
-    uv = rng.random((n, 2))
-    d = sample_bilinear(depth, uv)
-    t = d + (1.0 - d) * rng.random(n) ** 3  # favour points near the surface
-    return uv, t
-
-
-@pytest.mark.parametrize("name", ["spike", "noise_odd", "smooth_40x24", "wall", "checker"])
-def test_solid_distance_is_below_distance_to_the_bilinear_solid(name):
-    """d(voxel centre) <= |centre - Q| for sampled points Q of the real (bilinear) solid: S' contains it."""
+@pytest.mark.parametrize("name", ["spike", "noise_odd", "smooth_40x24", "checker", "wall"])
+def test_outer_solid_contains_the_bilinear_solid(name):
+    """Every point of the bilinear surface lies in its sub-cell's column: T <= D there (K = 1, 2, 4, 8)."""
     h = MAPS[name]
     rows, cols = h.shape
     depth = 1.0 - h.astype(np.float64)
+    uv = np.concatenate([RNG.random((5000, 2)), (np.indices((rows, cols)).reshape(2, -1)[::-1].T + 0.5)
+                         / (cols, rows)])  # random points and every texel centre
+    d = sample_bilinear(depth, uv)
+    for k in dist.SUBCELLS:
+        tops = dist.subcell_tops(depth, k)
+        a = np.floor((uv[:, 0] * cols - 0.5) * k).astype(int) % (cols * k)
+        b = np.floor((uv[:, 1] * rows - 0.5) * k).astype(int) % (rows * k)
+        assert (tops[b, a] <= d + 1e-12).all(), k
+
+
+@pytest.mark.parametrize("name", ["spike", "smooth_40x24", "walls", "checker"])
+def test_plain_value_holds_for_every_point_of_the_box(name):
+    """Stored value <= distance from any point of the voxel box to any point of the bilinear solid (sampled)."""
+    h = MAPS[name]
+    rows, cols = h.shape
     slices, s = 6, 0.3
-    d = dist.solid_distance(depth, slices, s)
-    uv, t = solid_samples(depth, 4000, np.random.default_rng(7))
-    X, Y, Z = uv[:, 0] * cols, uv[:, 1] * cols, t * s * cols
-    _, sy, sz = dist.spacing(cols, rows, slices, s)
-    for k, j, i in itertools.product(range(slices), range(rows), range(cols)):
-        dx = np.abs(X - (i + 0.5))
-        dx = np.minimum(dx, cols - dx)
-        dy = np.abs(Y - (j + 0.5) * sy)
-        dy = np.minimum(dy, cols - dy)  # the v period is W in the metric
-        nearest = np.sqrt(dx ** 2 + dy ** 2 + (Z - (k + 0.5) * sz) ** 2).min()
-        assert d[k, j, i] <= nearest + 1e-9, (k, j, i)
+    vol = maptools.generate("distance", h, backend="cpu", slices=slices, height_scale=s)
+    depth = 1.0 - h.astype(np.float64)
+    rng = np.random.default_rng(7)
+    uv = rng.random((6000, 2))
+    t = sample_bilinear(depth, uv)
+    t = t + (1.0 - t) * rng.random(len(t)) ** 3  # points of the solid, most near its surface
+    q = np.stack([uv[:, 0] * cols, uv[:, 1] * cols, t * s * cols], axis=1)
+    sy, dz = cols / rows, s * cols / slices
+    for _ in range(300):
+        k, j, i = rng.integers(slices), rng.integers(rows), rng.integers(cols)
+        p = np.array([i + rng.random(), (j + rng.random()) * sy, (k + rng.random()) * dz])
+        delta = np.abs(q - p)
+        delta[:, :2] = np.minimum(delta[:, :2], cols - delta[:, :2])  # periodic in X and Y (period W)
+        assert vol[k, j, i] <= np.linalg.norm(delta, axis=1).min() + 1e-9
 
 
 @pytest.mark.parametrize("value", [0.0, 1.0])
@@ -116,9 +115,9 @@ def test_flat_maps_are_analytic(value):
     h = np.full((8, 12), value, np.float32)
     slices, s = 8, 0.25
     vol = maptools.generate("distance", h, backend="cpu", slices=slices, height_scale=s)
-    t = dist.layer_depths(slices)
-    raw = (0.0 * t if value == 1.0 else 1.0 - t) * s * 12  # H = 1: solid from t = 0 on; H = 0: floor at t = 1
-    expect = np.maximum(raw - dist.half_diagonal(12, 8, slices, s) - dist.STORE_MARGIN, 0)
+    bottom = dist.box_bottoms(slices, s, 12)
+    raw = (1.0 - value) * s * 12 - bottom  # the floor at t = 1 - H below each box's bottom
+    expect = np.maximum(raw - dist.STORE_MARGIN, 0)
     assert vol.shape == (slices, 8, 12) and vol.dtype == np.float32
     assert np.allclose(vol, expect[:, None, None], atol=1e-6)
 
@@ -132,105 +131,264 @@ def test_roll_invariance_and_layout():
     assert (np.diff(maptools.generate("distance", np.zeros((4, 4), np.float32), backend="cpu"), axis=0) <= 1e-6).all()
 
 
-# -- conservative tracing: no ray may step past the exact first hit ------------------------------------
+def test_subcells_tighten_the_plain_map():
+    h = MAPS["smooth_40x24"]
+    vols = [maptools.generate("distance", h, backend="cpu", slices=8, height_scale=0.3, subcells=k)
+            for k in dist.SUBCELLS]
+    for coarse, fine in zip(vols, vols[1:]):
+        assert (fine >= coarse - 1e-6).all()
+    assert (vols[-1] > vols[0] + 1e-3).mean() > 0.2
 
-def cone_rays(n, max_angle, rng, grazing=()):
+
+def test_round_down_never_rounds_up():
+    v = np.concatenate([RNG.random(10000) * 100, [0.0, 1e-8, 65504.0, 1 / 3]])
+    for dtype in (np.float16, np.float32):
+        r = dist.round_down(v, dtype)
+        assert r.dtype == dtype and (r.astype(np.float64) <= v).all()
+        assert (np.abs(r.astype(np.float64) - v) <= np.maximum(np.abs(v) * np.finfo(dtype).eps, 1e-7)).all()
+
+
+# -- the refined map: columns, bins, the tracer's choice -------------------------------------------------
+
+def sample_wedge_rect(x0, x1, y0, y1, b, n=4000):
+    """Least |p| over points p of the rectangle whose azimuth is in the bin's wedge: random ones, the rectangle's
+    point nearest to 0, and dense points along the wedge's two edges (inf if none)."""
+    p = np.stack([x0 + (x1 - x0) * RNG.random(n), y0 + (y1 - y0) * RNG.random(n)], axis=1)
+    p = np.concatenate([p, [[np.clip(0, x0, x1), np.clip(0, y0, y1)]]])
+    if not b.full:
+        mid, half = 0.5 * (b.az_lo + b.az_hi), 0.5 * (b.az_hi - b.az_lo)
+        off = np.abs(np.mod(np.arctan2(p[:, 1], p[:, 0]) - mid + math.pi, 2 * math.pi) - math.pi)
+        t = np.linspace(0.0, 20.0, 20001)[:, None]
+        edges = [t * [math.cos(a), math.sin(a)] for a in (b.az_lo, b.az_hi)]
+        p = np.concatenate([p[(off <= half) | (np.hypot(*p.T) == 0)], *edges])
+    p = p[(p[:, 0] >= x0) & (p[:, 0] <= x1) & (p[:, 1] >= y0) & (p[:, 1] <= y1)]
+    return np.hypot(*p.T).min() if len(p) else np.inf
+
+
+@pytest.mark.parametrize("sectors", [1, 2, 4, 8, 16])
+def test_wedge_rho_is_the_least_length_in_the_wedge(sectors):
+    for b in rf.bins(sectors, 1, 80.0):
+        for _ in range(40):
+            x0, y0 = RNG.uniform(-6, 6, 2)
+            x1, y1 = x0 + RNG.uniform(0, 4), y0 + RNG.uniform(0, 4)
+            rho = float(rf.wedge_rho(np.array([x0]), np.array([x1]), np.array([y0]), np.array([y1]), b)[0])
+            sampled = sample_wedge_rect(x0, x1, y0, y1, b)
+            assert rho <= sampled + 1e-12  # never above any point of the rect in the wedge
+            if np.isfinite(sampled):
+                assert rho >= sampled - 2e-3  # and equal to the least length, up to the sampling
+
+
+@pytest.mark.parametrize("sectors,sy,reach", [(8, 1.0, 16.0), (1, 1.0, 6.0), (4, 1.7, 9.0), (2, 0.6, 5.0)])
+def test_entries_cover_every_column_in_reach_once(sectors, sy, reach):
+    """Each sub-cell offset within reach of the bin lies in exactly one final entry; entries never claim a rho
+    above the least rho of the sub-cells they stand for."""
+    k = 4
+    b = rf.bins(sectors, 1, 80.0)[sectors // 2]
+    e = rf.entries(b, k, sy, reach)
+    ax, ay = 0.5 + dist.BOX_GROW, 0.5 * sy + dist.BOX_GROW
+    covered: dict[tuple[int, int], int] = {}
+    for q in np.flatnonzero(e.final):
+        if e.level[q] == 0:
+            subs = [(e.ox[q], e.oy[q])]
+        else:
+            size = 1 << (e.level[q] - 1)
+            subs = [(k * (e.ox[q] + cx) + u, k * (e.oy[q] + cy) + v)
+                    for cx in range(size) for cy in range(size) for u in range(k) for v in range(k)]
+        sx, sy_ = np.array(subs).T
+        srho = rf.wedge_rho(sx / k - ax, (sx + 1) / k + ax, sy_ / k * sy - ay, (sy_ + 1) / k * sy + ay, b)
+        assert e.rho[q] <= srho.min() + 1e-12
+        for s in subs:
+            covered[s] = covered.get(s, 0) + 1
+    assert max(covered.values()) == 1
+    r = math.ceil(reach * k) + 2 * k
+    oy, ox = np.mgrid[-r:r + 1, -r:r + 1]
+    ox, oy = ox.ravel(), oy.ravel()
+    srho = rf.wedge_rho(ox / k - ax, (ox + 1) / k + ax, oy / k * sy - ay, (oy + 1) / k * sy + ay, b)
+    need = {(int(x), int(y)) for x, y, q in zip(ox, oy, srho) if q < reach}
+    assert need <= set(covered)
+    heads = np.flatnonzero(e.children > 0)
+    assert all((e.level[q + 1:q + 1 + e.children[q]] == 0).all() for q in heads)
+    outer = np.flatnonzero(e.level > 0)
+    assert (np.diff(e.rho[outer]) >= 0).all()  # cells and windows sorted by rho
+
+
+def test_band_edges_have_equal_cosine_ratios():
+    edges = rf.band_edges(8, 80.0)
+    cos = np.cos([0.0, *edges, np.radians(80.0)])
+    assert len(edges) == 7 and np.allclose(cos[1:] / cos[:-1], np.cos(np.radians(80.0)) ** (1 / 8))
+    assert rf.band_edges(1, 80.0) == []
+
+
+def test_bins_and_the_tracers_choice():
+    """volume_index picks the bin whose azimuth sector and polar band hold the ray's direction (w = (-V.x, -V.y,
+    V.z)), rays steeper than max_angle the plain volume (last); the bins tile the cone."""
+    bins = rf.bins(8, 4, 80.0)
+    assert len(bins) == 32
+    edges = np.degrees(rf.band_edges(4, 80.0))
+    theta = np.concatenate([RNG.uniform(0, 89.9, 4000), edges, [0.0, 80.0, 80.001, 89.0]])
+    phi = RNG.uniform(0, 360, len(theta))
+    phi[-8:] = (0, 45, 90, 135, 180, 225, 270, 315)
+    v = view_dir_from_angles(theta, phi)
+    which = rf.volume_index(v, 8, 4, 80.0)
+    w = v * [-1, -1, 1]
+    polar = np.arccos(np.clip(w[:, 2], -1, 1))
+    az = np.arctan2(w[:, 1], w[:, 0])
+    for n in range(len(v)):
+        if which[n] == len(bins):
+            assert theta[n] > 80.0 - 1e-9
+            continue
+        b = bins[which[n]]
+        assert b.polar_lo <= polar[n] <= b.polar_hi
+        assert b.az_lo <= az[n] <= b.az_hi or polar[n] < 1e-9
+    assert (which[theta > 80.0 + 1e-6] == len(bins)).all()
+
+
+def test_refined_volumes_layout_and_floor():
+    h = MAPS["smooth_40x24"]
+    opts = {"slices": 6, "height_scale": 0.3}
+    plain = maptools.generate("distance", h, backend="cpu", **opts)
+    vol = maptools.generate("distance_refined", h, backend="cpu", sectors=4, bands=3, **opts)
+    assert vol.shape == (4 * 3 + 1, 6, 24, 40) and vol.dtype == np.float16
+    assert np.array_equal(vol[-1], dist.round_down(plain.astype(np.float64), np.float16))
+    assert (vol[:-1].astype(np.float64) >= vol[-1].astype(np.float64)).all()  # never below the plain value
+    assert (vol[:-1] > vol[-1]).mean() > 0.2  # and raised where the bins allow
+    cone = maptools.generate("distance_refined", h, backend="cpu", sectors=1, bands=1, **opts)
+    assert cone.shape == (2, 6, 24, 40)  # the paper's single cone, then the plain volume
+
+
+# -- safety: no ray passes the exact hit ------------------------------------------------------------
+
+def cone_rays(n, max_angle, rng):
     uv = rng.random((n, 2)) * 3 - 1  # also outside [0, 1): repeat addressing
     cos_t = 1 - rng.random(n) * (1 - np.cos(np.radians(max_angle)))  # uniform over the cone's solid angle
-    theta = np.degrees(np.arccos(cos_t))
-    theta[: len(grazing)] = grazing
-    return uv, view_dir_from_angles(theta, rng.random(n) * 360)
+    return uv, view_dir_from_angles(np.degrees(np.arccos(cos_t)), rng.random(n) * 360)
 
 
-def traced(vol, h, s, uv, v):
-    hit = exact_hit(1.0 - h.astype(np.float64), uv, v, s)
-    t, steps, capped = sphere_trace(vol, uv, v, s, stop=0.05, max_steps=400)
-    assert hit.valid.all()
-    return hit.t, t, steps, capped
+def adversarial_rays(n, shape, edges, sectors, rng):
+    """Rays at exactly the cone's edge and just past it, on band edges, on sector boundaries (+-1e-12 rad),
+    entering at texel corners and centres, near vertical and grazing."""
+    rows, cols = shape
+    parts = []
+    for theta in (80.0, 80.0 + 1e-9, 79.999999, 85.0, 89.0, 0.0, 1e-6, *edges):
+        parts.append((rng.random((n, 2)), view_dir_from_angles(np.full(n, theta), rng.random(n) * 360)))
+    # metric azimuth atan2(-V.y, -V.x) on the sector edges: V's azimuth is that + 180 degrees
+    edge = np.repeat(np.arange(sectors), n // sectors + 1)[:n] * 360.0 / sectors
+    for eps in (-1e-12, 0.0, 1e-12):
+        theta = np.degrees(np.arccos(1 - rng.random(n) * (1 - np.cos(np.radians(80.0)))))
+        parts.append((rng.random((n, 2)), view_dir_from_angles(theta, edge + 180.0 + np.degrees(eps))))
+    corners = (rng.integers(0, max(cols, rows), (n, 2)) + rng.choice([0.0, 0.5], (n, 2))) / (cols, rows)
+    parts.append((corners, cone_rays(n, 80.0, rng)[1]))
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
 
 TRACE_CASES = [("walls", 0.5, 16), ("noise", 0.6, 12), ("spike", 0.5, 8), ("wall", 0.4, 8), ("checker", 0.5, 8),
                ("smooth_40x24", 0.5, 12), ("step", 0.3, 10), ("flat1", 0.2, 4), ("one_texel", 0.1, 4)]
+BANDS = 4
 
 
 @pytest.mark.parametrize("name,s,slices", TRACE_CASES)
 def test_sphere_tracing_never_tunnels(name, s, slices):
+    """docs/maps.md's loop with a tiny stop radius through the plain map and the refined map (each ray reading its
+    own volume): the stop point is never behind the float64 exact hit."""
     h = MAPS[name]
     rng = np.random.default_rng(len(name))
     plain = maptools.generate("distance", h, backend="cpu", slices=slices, height_scale=s)
-    refined = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s,
-                                max_angle=80.0, angle_step=10.0)
-    assert (refined >= plain - 1e-6).all()
-    uv, v = cone_rays(1500, 80.0, rng, grazing=(80.0, 79.99, 60.0, 0.0))
-    for vol in (plain, refined):
-        t_hit, t, _, _ = traced(vol, h, s, uv, v)
-        assert (t <= t_hit + 1e-9).all(), f"{int((t > t_hit + 1e-9).sum())} rays tunnelled"
+    refined = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s, sectors=8,
+                                bands=BANDS, reach=8.0)
+    uv, v = cone_rays(1500, 89.0, rng)
+    uv2, v2 = adversarial_rays(120, h.shape, np.degrees(rf.band_edges(BANDS, 80.0)), 8, rng)
+    uv, v = np.concatenate([uv, uv2]), np.concatenate([v, v2])
+    hit = exact_hit(1.0 - h.astype(np.float64), uv, v, s)
+    assert hit.valid.all()
+    for vol, which in ((plain, None), (refined, rf.volume_index(v, 8, BANDS, 80.0))):
+        t, _, _ = sphere_trace(vol, uv, v, s, stop=1e-3, max_steps=600, which=which)
+        assert (t <= hit.t + 1e-9).all(), f"{int((t > hit.t + 1e-9).sum())} rays tunnelled"
 
 
-def test_rescaled_map_stays_conservative():
+def free_paths(depth, p, w, s):
+    """Exact free path (metric) from points p (N, 3) along unit metric directions w (N, 3), and whether the state is
+    reachable (the line from the top plane to p is free): through the float64 exact hit of the whole line."""
+    rows, cols = depth.shape
+    sw = s * cols
+    back = p[:, 2] / w[:, 2]
+    top = p - back[:, None] * w
+    v = np.stack([-w[:, 0], -w[:, 1], w[:, 2]], axis=1)
+    hit = exact_hit(depth, top[:, :2] / cols, v, s)
+    t_p = p[:, 2] / sw
+    per_t = sw / w[:, 2]  # metric length per unit of t along w
+    return (hit.t - t_p) * per_t, hit.valid & (hit.t >= t_p)
+
+
+@pytest.mark.parametrize("name", ["walls", "spike", "checker", "smooth_40x24", "wall", "step", "noise_odd"])
+def test_refined_value_never_exceeds_the_free_path(name):
+    """The stored invariant itself: for random states (p above the surface, w uniform in a bin, on its edges too)
+    that a ray can reach (the line from the top plane to p is free), the value of p's voxel in w's bin is at most
+    the exact free path from p along w."""
+    h = MAPS[name]
+    rows, cols = h.shape
+    slices, s = 8, 0.4
+    vol = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s, sectors=8,
+                            bands=BANDS, reach=8.0).astype(np.float64)
+    depth = 1.0 - h.astype(np.float64)
+    rng = np.random.default_rng(3)
+    n = 20000
+    uv = rng.random((n, 2))
+    t = sample_bilinear(depth, uv) * rng.random(n)  # above the surface: the states a ray may be in
+    p = np.stack([uv[:, 0] * cols, uv[:, 1] * cols, t * s * cols], axis=1)
+    bins = rf.bins(8, BANDS, 80.0)
+    which = rng.integers(0, len(bins), n)
+    lo = np.array([b.polar_lo for b in bins])[which]
+    hi = np.array([b.polar_hi for b in bins])[which] - rf.ANGLE_SLACK
+    polar = np.arccos(np.cos(lo) - rng.random(n) * (np.cos(lo) - np.cos(hi)))
+    polar = np.where(rng.random(n) < 0.1, hi, polar)  # on the band's far edge too
+    az_lo = np.array([b.az_lo for b in bins])[which] + rf.ANGLE_SLACK
+    az = az_lo + rng.random(n) * 2 * np.pi / 8
+    az = np.where(rng.random(n) < 0.1, az_lo, az)  # on the sector's edge too
+    w = np.stack([np.sin(polar) * np.cos(az), np.sin(polar) * np.sin(az), np.cos(polar)], axis=1)
+    free, reachable = free_paths(depth, p, w, s)
+    i = np.floor(p[:, 0]).astype(int) % cols
+    j = np.floor(p[:, 1] * rows / cols).astype(int) % rows
+    k = np.clip(np.floor(p[:, 2] / (s * cols / slices)).astype(int), 0, slices - 1)
+    value = vol[which, k, j, i]
+    assert reachable.sum() > 2000
+    over = reachable & (value > free + 1e-9)
+    assert not over.any(), f"{int(over.sum())} states: value above the free path, worst {(value - free)[over].max()}"
+    assert (value[reachable] > vol[-1, k, j, i][reachable]).mean() > 0.1  # the bins do raise values
+
+
+@pytest.mark.parametrize("name", ["walls", "noise"])
+def test_rescaled_plain_map_stays_conservative(name):
     """A plain map built for S0, used at S with every value times min(1, S / S0) (docs/maps.md)."""
-    h = MAPS["noise"]
+    h = MAPS[name]
     s0 = 0.4
     vol = maptools.generate("distance", h, backend="cpu", slices=12, height_scale=s0)
     rng = np.random.default_rng(3)
     for s in (0.1, 0.25, 0.8):
         uv, v = cone_rays(1000, 85.0, rng)
-        t_hit, t, _, _ = traced(vol * np.float32(min(1.0, s / s0)), h, s, uv, v)
-        assert (t <= t_hit + 1e-9).all(), s
-
-
-def test_refined_step_counts_reported(capsys):
-    """Same rays, same stop rule: mean sphere-tracing steps with distance vs distance_refined (reported)."""
-    h = walls(48, 12, 3)
-    s, slices = 0.5, 16
-    plain = maptools.generate("distance", h, backend="cpu", slices=slices, height_scale=s)
-    refined = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s,
-                                max_angle=60.0, angle_step=6.0)
-    uv, v = cone_rays(3000, 60.0, np.random.default_rng(11))
-    rows = []
-    for vol in (plain, refined):
-        t_hit, t, steps, capped = traced(vol, h, s, uv, v)
-        assert (t <= t_hit + 1e-9).all()
-        err = (t_hit - t) * s * 48 / v[:, 2]  # along the ray, texels
-        rows.append((steps.mean(), err.mean(), int(capped.sum())))
-    with capsys.disabled():
-        print(f"\n  walls48 S=0.5 cone 60: plain steps {rows[0][0]:.2f} err {rows[0][1]:.3f} | "
-              f"refined steps {rows[1][0]:.2f} err {rows[1][1]:.3f}; "
-              f"voxels raised {(refined > plain + 1e-6).mean():.3f}")
-    assert rows[1][0] <= rows[0][0] + 1e-9
-
-
-# -- directions --------------------------------------------------------------------------------------
-
-@pytest.mark.parametrize("max_angle,step", [(80.0, 6.0), (45.0, 10.0), (89.0, 3.0), (5.0, 6.0)])
-def test_cone_directions_cover_the_cone(max_angle, step):
-    dirs, alpha = dist.cone_directions(max_angle, step)
-    assert alpha <= np.radians(step) + 1e-12
-    assert np.allclose(np.linalg.norm(dirs, axis=1), 1)
-    assert (np.degrees(np.arccos(dirs[:, 2])) <= max_angle + 1e-9).all()
-    _, v = cone_rays(20000, max_angle, np.random.default_rng(2))
-    w = v * [-1, -1, 1]
-    worst = np.arccos(np.clip(w @ dirs.T, -1, 1)).min(axis=1).max()
-    assert worst <= alpha + 1e-9
+        hit = exact_hit(1.0 - h.astype(np.float64), uv, v, s)
+        t, _, _ = sphere_trace(vol * np.float32(min(1.0, s / s0)), uv, v, s, stop=1e-3, max_steps=600)
+        assert (t <= hit.t + 1e-9).all(), s
 
 
 # -- GPU vs CPU -----------------------------------------------------------------------------------------
 
-GPU_CASES = [("smooth_40x24", 0.3, 8), ("noise_odd", 0.5, 6), ("spike", 0.5, 4), ("walls", 0.5, 6),
-             ("flat0", 0.2, 3), ("one_texel", 0.1, 3), ("checker", 0.4, 5)]
+GPU_CASES = [("smooth_40x24", 0.3, 8, {}), ("noise_odd", 0.5, 6, {"subcells": 1}), ("spike", 0.5, 4, {}),
+             ("walls", 0.5, 6, {"subcells": 8}), ("flat0", 0.2, 3, {}), ("one_texel", 0.1, 3, {}),
+             ("checker", 0.4, 5, {"subcells": 2})]
+REFINED_GPU = ({}, {"sectors": 1, "bands": 1}, {"sectors": 16, "bands": 6, "reach": 5.0})
 
 
 @pytest.mark.requires_gpu
-@pytest.mark.parametrize("name,s,slices", GPU_CASES)
-def test_gpu_matches_cpu(name, s, slices):
+@pytest.mark.parametrize("name,s,slices,extra", GPU_CASES)
+def test_gpu_matches_cpu(name, s, slices, extra):
     h = MAPS[name]
-    for kind, extra in (("distance", {}), ("distance_refined", {"angle_step": 12.0})):
-        opts = {"slices": slices, "height_scale": s, **extra}
+    for kind, more in [("distance", {})] + [("distance_refined", r) for r in REFINED_GPU]:
+        opts = {"slices": slices, "height_scale": s, **extra, **more}
         a = maptools.generate(kind, h, backend="cpu", **opts)
         b = maptools.generate(kind, h, backend="gpu", **opts)
-        assert b.shape == a.shape == (slices,) + h.shape and b.dtype == np.float32
+        assert b.shape == a.shape and b.dtype == a.dtype
         c = KINDS[kind].compare(a, b, KINDS[kind].resolve(opts))
-        assert c.ok, (kind, name, c)
+        assert c.ok, (kind, name, opts, c)
 
 
 # -- options, limits, CLI -----------------------------------------------------------------------------
@@ -238,18 +396,23 @@ def test_gpu_matches_cpu(name, s, slices):
 @pytest.mark.parametrize("kind,bad,needle", [
     ("distance", {"slices": 0}, "out of range"), ("distance", {"height_scale": 0.0}, "out of range"),
     ("distance", {"height_scale": float("nan")}, "finite"), ("distance", {"slices": 2.5}, "valid int"),
+    ("distance", {"subcells": 3}, "expected one of"), ("distance", {"bogus": 1}, "unknown option"),
     ("distance_refined", {"max_angle": 90.0}, "out of range"),
-    ("distance_refined", {"max_angle": 10.0, "angle_step": 20.0}, "angle_step"),
-    ("distance_refined", {"angle_step": 0.5}, "directions"), ("distance", {"bogus": 1}, "unknown option"),
+    ("distance_refined", {"sectors": 3}, "expected one of"), ("distance_refined", {"bands": 0}, "out of range"),
+    ("distance_refined", {"bands": 17}, "out of range"), ("distance_refined", {"bands": 2.5}, "valid int"),
+    ("distance_refined", {"reach": 0.5}, "out of range"),
 ])
 def test_bad_options(kind, bad, needle):
     with pytest.raises(UserError, match=needle):
         maptools.generate(kind, MAPS["spike"], backend="cpu", **bad)
 
 
-def test_volume_limit():
-    with pytest.raises(UserError, match="voxels, more than the limit"):
+def test_volume_limits():
+    with pytest.raises(UserError, match="more than the limit"):
         maptools.generate("distance", np.zeros((1024, 1024), np.float32), backend="cpu", slices=16)
+    with pytest.raises(UserError, match="float16"):
+        maptools.generate("distance_refined", np.zeros((512, 512), np.float32), backend="cpu", slices=32,
+                          sectors=16, bands=3)
 
 
 def test_cli_generate_distance(tmp_path):
@@ -257,12 +420,15 @@ def test_cli_generate_distance(tmp_path):
     np.save(tmp_path / "h.npy", h)
     out = tmp_path / "d.npy"
     assert cli.main(["generate", "distance", str(tmp_path / "h.npy"), "-o", str(out), "--backend", "cpu",
-                     "--slices", "6", "--height-scale", "0.3"]) == 0
+                     "--slices", "6", "--height-scale", "0.3", "--subcells", "2"]) == 0
     vol = np.load(out)
     assert vol.dtype == np.float32 and vol.shape == (6, 12, 16)
-    assert np.array_equal(vol, maptools.generate("distance", h, backend="cpu", slices=6, height_scale=0.3))
+    assert np.array_equal(vol, maptools.generate("distance", h, backend="cpu", slices=6, height_scale=0.3,
+                                                 subcells=2))
     assert cli.main(["generate", "distance_refined", str(tmp_path / "h.npy"), "-o", str(tmp_path / "r.npy"),
-                     "--backend", "cpu", "--slices", "4", "--angle-step", "15"]) == 0
+                     "--backend", "cpu", "--slices", "4", "--sectors", "4", "--bands", "2"]) == 0
+    refined = np.load(tmp_path / "r.npy")
+    assert refined.dtype == np.float16 and refined.shape == (4 * 2 + 1, 4, 12, 16)
     assert cli.main(["generate", "distance", str(tmp_path / "h.npy"), "-o", str(tmp_path / "d.png"),
                      "--backend", "cpu"]) == 2
 

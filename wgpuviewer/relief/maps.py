@@ -21,7 +21,7 @@ from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 
 from . import autotable
-from .techniques import REFINED_MAX_ANGLE
+from .techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 
 
 @dataclass(frozen=True)
@@ -167,18 +167,22 @@ def _auto_table(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str, pr
 
 
 def _volume_texture(gpu: Gpu, volume: np.ndarray, label: str) -> wgpu.GPUTexture:
-    dz, h, w = volume.shape
+    """A (Dz, H, W) float32 volume as an r32float 3D texture, or (V, Dz, H, W) float16 volumes stacked along the
+    depth as r16float (volume v at depths [v Dz, (v + 1) Dz))."""
+    half = volume.dtype == np.float16
+    data = np.ascontiguousarray(volume.reshape(-1, *volume.shape[-2:]), np.float16 if half else np.float32)
+    depth, h, w = data.shape
     limit = gpu.adapter.limits["max-texture-dimension-3d"]
-    if max(w, h, dz) > limit:
-        raise UserError(f"{label}: volume of {w}x{h}x{dz} exceeds this adapter's 3D limit of {limit} texels per side")
-    data = np.ascontiguousarray(volume, np.float32)
+    if max(w, h, depth) > limit:
+        raise UserError(f"{label}: volume of {w}x{h}x{depth} exceeds this adapter's 3D limit of {limit} texels per "
+                        f"side; use a smaller height map")
     texture = gpu.device.create_texture(
-        label=label, size=(w, h, dz), dimension="3d", format="r32float",
+        label=label, size=(w, h, depth), dimension="3d", format="r16float" if half else "r32float",
         usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
     )
     gpu.device.queue.write_texture(
         {"texture": texture, "mip_level": 0, "origin": (0, 0, 0)}, data,
-        {"offset": 0, "bytes_per_row": w * 4, "rows_per_image": h}, (w, h, dz),
+        {"offset": 0, "bytes_per_row": w * data.itemsize, "rows_per_image": h}, (w, h, depth),
     )
     return texture
 
@@ -190,9 +194,10 @@ def _distance(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> w
 
 
 def _distance_refined(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
-    volume = cached_generate("distance_refined", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
-                             height_scale=height_scale, max_angle=REFINED_MAX_ANGLE)
-    return _volume_texture(gpu, volume, label)
+    volumes = cached_generate("distance_refined", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
+                              height_scale=height_scale, max_angle=REFINED_MAX_ANGLE, sectors=REFINED_SECTORS,
+                              bands=REFINED_BANDS)
+    return _volume_texture(gpu, volumes, label)
 
 
 def _cone(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
@@ -229,7 +234,8 @@ MAP_SLOTS: dict[str, MapSlot] = {
         MapSlot("distance", _3D, _VOLUME, _distance, "distance volume (W, H, slices), r32float, textureLoad",
                 scale_bound=True),
         MapSlot("distance_refined", _3D, _VOLUME, _distance_refined,
-                "visibility-refined distance volume, same layout", scale_bound=True, variable="distance_tex"),
+                "direction-binned refined volumes and the plain one, stacked along the depth (r16float), textureLoad",
+                scale_bound=True, variable="distance_tex"),
         MapSlot("cone", _2D, _UNFILTERABLE_2D, _cone,
                 "relaxed cone ratios (r32float), texels of u per unit t, textureLoad"),
         MapSlot("quadmax", "texture_2d<u32>", _UINT_2D, _quadmax,

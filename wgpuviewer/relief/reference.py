@@ -114,6 +114,30 @@ def _first_root(a, b, c, length):
     return np.where(np.isfinite(best), np.clip(best, 0.0, length), np.nan)
 
 
+def cell_root(flat, rows: int, cols: int, cx, cy, x0, y0, ax, ay, t_enter, t_exit, address: str = "repeat"):
+    """Smallest s >= 0 with t - D = 0 at t = t_enter + s inside cell (cx, cy) for the rays (x, y)(t) = (x0, y0) +
+    t (ax, ay) (texel coordinates) over [t_enter, t_exit]: 0 where the entry point is already on or below the
+    surface; NaN where the cell holds no hit. ``flat`` is the depth map raveled (rows, cols)."""
+    length = t_exit - t_enter
+    # D inside the cell = A + B fx + C fy + E fx fy with local coordinates fx, fy in [0, 1].
+    # Expanding around the entry point (s = t - t_enter) rather than t = 0 keeps the
+    # constant terms O(1) however far the ray has travelled, so nothing cancels.
+    c00, c10, c01, c11 = _corners(flat, rows, cols, cx, cy, address)
+    b_x = c10 - c00
+    c_y = c01 - c00
+    e_xy = c11 - c10 - c01 + c00
+    ex = np.clip(x0 + t_enter * ax - cx, 0.0, 1.0)
+    ey = np.clip(y0 + t_enter * ay - cy, 0.0, 1.0)
+    # f(s) = t - D = qa s^2 + qb s + qc
+    qc = t_enter - (c00 + b_x * ex + c_y * ey + e_xy * ex * ey)
+    qb = 1.0 - (b_x * ax + c_y * ay + e_xy * (ex * ay + ey * ax))
+    qa = -e_xy * ax * ay
+    s = np.where(qc >= 0.0, 0.0, _first_root(qa, qb, qc, length))
+    # A root that rounding pushed just past the cell end is caught by the next cell's
+    # entry test; at t = 1 there is no next cell, and f(1) >= 0 guarantees a hit there.
+    return np.where(np.isnan(s) & (t_exit >= 1.0), length, s)
+
+
 def exact_hit(
     depth, uv, view_dir, height_scale, address: str = "repeat", max_cells: int = MAX_CELLS
 ) -> Hit:
@@ -184,26 +208,7 @@ def exact_hit(
             tx = np.where(ax != 0, (cx + (sx > 0) - x0) / ax, np.inf)
             ty = np.where(ay != 0, (cy + (sy > 0) - y0) / ay, np.inf)
             t_exit = np.minimum(np.minimum(tx, ty), 1.0)
-            length = t_exit - t_enter
-
-            # D inside the cell = A + B fx + C fy + E fx fy with local coordinates fx, fy in [0, 1].
-            # Expanding around the entry point (s = t - t_enter) rather than t = 0 keeps the
-            # constant terms O(1) however far the ray has travelled, so nothing cancels.
-            c00, c10, c01, c11 = _corners(flat, rows, cols, cx, cy, address)
-            b_x = c10 - c00
-            c_y = c01 - c00
-            e_xy = c11 - c10 - c01 + c00
-            ex = np.clip(x0 + t_enter * ax - cx, 0.0, 1.0)
-            ey = np.clip(y0 + t_enter * ay - cy, 0.0, 1.0)
-            # f(s) = t - D = qa s^2 + qb s + qc
-            qc = t_enter - (c00 + b_x * ex + c_y * ey + e_xy * ex * ey)
-            qb = 1.0 - (b_x * ax + c_y * ay + e_xy * (ex * ay + ey * ax))
-            qa = -e_xy * ax * ay
-
-            s = np.where(qc >= 0.0, 0.0, _first_root(qa, qb, qc, length))
-            # A root that rounding pushed just past the cell end is caught by the next cell's
-            # entry test; at t = 1 there is no next cell, and f(1) >= 0 guarantees a hit there.
-            s = np.where(np.isnan(s) & (t_exit >= 1.0), length, s)
+            s = cell_root(flat, rows, cols, cx, cy, x0, y0, ax, ay, t_enter, t_exit, address)
 
             done = ~np.isnan(s)
             if done.any():

@@ -112,8 +112,11 @@ class Technique(Parametrized):
         return COMMON_COST_SCALE
 
 
-#: The admissible view cone (half-angle from the normal, degrees) the refined distance map is built for
-#: (maps.py passes it to maptools' distance_refined kind); steeper rays get no refined steps (see distance.wgsl).
+#: The refined distance map's direction bins (maps.py builds it with these maptools distance_refined options; the
+#: tracer picks a ray's volume from the same numbers, see distance.wgsl): azimuth sectors, polar bands (edges of
+#: equal cosine ratio) and the binned cone's half-angle; steeper rays read the plain volume stored last.
+REFINED_SECTORS = 4
+REFINED_BANDS = 8
 REFINED_MAX_ANGLE = 80.0
 
 
@@ -147,6 +150,15 @@ def _layer_search(name: str, key: str, description: str) -> Technique:
         (Param("layers", 16, 1, MAX_LAYERS, int, "layer count: the ray is tested at this many evenly spaced depths"),),
         ray_search=True, fetch_bound=lambda p: p["layers"] + 1,
     )
+
+
+def distance_fixed(sectors: int, bands: int, max_angle: float | None) -> tuple[tuple[str, float], ...]:
+    """TraceParams values of distance.wgsl for a texture of ``sectors`` x ``bands`` direction volumes plus the plain
+    one (max_angle = None: the plain map alone, one volume every ray reads)."""
+    if max_angle is None:
+        return (("sectors", 1.0), ("bands", 1.0), ("steep_cos", -2.0), ("volumes", 1.0))
+    return (("sectors", float(sectors)), ("bands", float(bands)), ("steep_cos", math.cos(math.radians(max_angle))),
+            ("volumes", float(sectors * bands + 1)))
 
 
 TECHNIQUES: dict[str, Technique] = {
@@ -213,22 +225,24 @@ TECHNIQUES: dict[str, Technique] = {
         ),
         Technique(
             "distance", "9",
-            "Distance-map parallax (Donnelly): sphere tracing through a 3D map of safe radii; where the radius is "
-            "0 the current bilinear cell is solved exactly and skipped if it holds no hit. Never passes a surface.",
+            "Distance-map parallax (Donnelly): sphere tracing through a 3D map of safe radii (box-exact distance to a "
+            "sub-cell outer solid); where the radius does not leave the current bilinear cell the cell is solved "
+            "exactly and skipped if it holds no hit. Never passes a surface.",
             "one volume fetch per step + one 2x2 gather per exact cell", ("albedo", "normal", "depth", "distance"),
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
-            ray_search=True, fixed=(("cone_cos", -1.0),), fetch_bound=lambda p: 2 * p["iterations"], exact=True,
+            ray_search=True, fixed=distance_fixed(1, 1, None), fetch_bound=lambda p: 2 * p["iterations"], exact=True,
         ),
         Technique(
             "distance_refined", "0",
-            "Distance-map parallax on the visibility-refined map (seed 000): the same tracer as distance "
-            "(distance.wgsl), the map stores longer safe steps for rays within the admissible view cone "
-            f"({REFINED_MAX_ANGLE:g} degrees); steeper rays take only exact cell steps.",
+            "Distance-map parallax on the direction-binned refined map (seed 000): the same tracer as distance "
+            f"(distance.wgsl); the map has one volume per bin of ray directions ({REFINED_SECTORS} azimuth sectors x "
+            f"{REFINED_BANDS} polar bands within {REFINED_MAX_ANGLE:g} degrees) with longer safe steps for "
+            "the rays of that bin, and the plain volume for steeper rays. A ray picks its volume once.",
             "one volume fetch per step + one 2x2 gather per exact cell",
             ("albedo", "normal", "depth", "distance_refined"),
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
             ray_search=True, wgsl="distance.wgsl", fetch_bound=lambda p: 2 * p["iterations"], exact=True,
-            fixed=(("cone_cos", math.cos(math.radians(REFINED_MAX_ANGLE))),),
+            fixed=distance_fixed(REFINED_SECTORS, REFINED_BANDS, REFINED_MAX_ANGLE),
         ),
         Technique(
             "quadmax", "-",

@@ -1,66 +1,91 @@
-// 3D distance map (Donnelly) in the texel metric of docs/maps.md, three passes:
-//   tops:    per texel, min (solid) or max (free space) of the depth D = 1 - H over the 3x3 texels around it (wrap)
-//   pass_x:  g1(i, j, k) = min over columns qx of wrapdx^2 + ((E(qx, j) - t_k)^+ * S*W)^2   (solid; free: (t_k - E)^+)
-//   pass_y:  d^2(i, j, k) = min over rows qy of (W/H)^2 wrapdy^2 + g1(i, qy, k); out = d (raw) or
-//            max(0, d - half voxel diagonal - margin) (stored)
-// Brute force over offsets: exact, O(W + H) per voxel, loops bounded by the map size (<= the volume limit).
-// Volumes are f32 buffers indexed (k * H + j) * W + i.
+// The plain 3D distance map (maptools/distance.py is the CPU twin; docs/maps.md the metric and the argument):
+// per voxel the exact distance from its (grown) box to the outer solid of K x K sub-cell columns per bilinear cell.
+//   tops:       per sub-cell, the least bilinear depth at its four corners, times S*W (metric Z of the column top)
+//   pass_x:     g(i, b, k) = min over sub-cell columns a of row b: gap_u(i, a)^2 + max(top - box bottom, 0)^2
+//   pass_y:     d(i, j, k)^2 = min over sub-cell rows b: gap_v(j, b)^2 + g(i, b, k); stored max(d - margin, 0)
+// The passes walk offsets outwards in pairs of equal gap and stop once the gap alone reaches the best value: exact,
+// bounded by half a period. Volumes are f32 buffers indexed (k * rows + row) * W + i.
 // #include "common/map_buffers.wgsl"
 
 struct Params {
     width: u32,
     height: u32,
     slices: u32,
-    mode: u32,        // tops: 0 = min (solid), 1 = max (free space); pass_x: same; pass_y: 0 = raw d, 1 = stored
-    sw: f32,          // S * W: metric length of the whole depth range t in [0, 1]
-    aspect2: f32,     // (W / H)^2
-    subtract: f32,    // half voxel diagonal + rounding margin (pass_y, mode 1)
-    _pad: f32,
+    subcells: u32,   // K
+    sw: f32,         // S * W: metric length of the whole depth range t in [0, 1]
+    sy: f32,         // W / H: metric height of one texel row
+    dz: f32,         // metric thickness of one slice
+    grow: f32,       // every voxel box is grown by this on each side (maptools.distance.BOX_GROW)
+    margin: f32,     // subtracted from every stored distance
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
 };
+
+// Bilinear depth (repeat) at the sub-cell vertex (a, b): X = 0.5 + a / K, Y = (0.5 + b / K) * sy.
+fn vertex_depth(a: u32, b: u32) -> f32 {
+    let k = P.subcells;
+    let x0 = a / k;
+    let y0 = b / k;
+    let x1 = (x0 + 1u) % P.width;
+    let y1 = (y0 + 1u) % P.height;
+    let fx = f32(a % k) / f32(k);
+    let fy = f32(b % k) / f32(k);
+    let r0 = (1.0 - src[y0 * P.width + x0]) * (1.0 - fx) + (1.0 - src[y0 * P.width + x1]) * fx;
+    let r1 = (1.0 - src[y1 * P.width + x0]) * (1.0 - fx) + (1.0 - src[y1 * P.width + x1]) * fx;
+    return r0 * (1.0 - fy) + r1 * fy;
+}
 
 @compute @workgroup_size(8, 8, 1)
 fn tops(@builtin(global_invocation_id) gid: vec3u) {
-    if (gid.x >= P.width || gid.y >= P.height || gid.z != 0u) { return; }
-    let w = i32(P.width);
-    let h = i32(P.height);
-    var m = 1.0 - src[gid.y * P.width + gid.x];
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let d = 1.0 - src[u32(wrap_index(i32(gid.y) + dy, h) * w + wrap_index(i32(gid.x) + dx, w))];
-            if (P.mode == 0u) { m = min(m, d); } else { m = max(m, d); }
-        }
-    }
-    dst[gid.y * P.width + gid.x] = m;
+    let wk = P.width * P.subcells;
+    let hk = P.height * P.subcells;
+    if (gid.x >= wk || gid.y >= hk || gid.z != 0u) { return; }
+    let a1 = (gid.x + 1u) % wk;
+    let b1 = (gid.y + 1u) % hk;
+    let m = min(min(vertex_depth(gid.x, gid.y), vertex_depth(a1, gid.y)),
+                min(vertex_depth(gid.x, b1), vertex_depth(a1, b1)));
+    dst[gid.y * wk + gid.x] = m * P.sw;
+}
+
+// Gap along one axis between a voxel box (half-extent step / 2 + grow) and the sub-cell K n + o (or K n - 1 - o) of
+// its own index n, o >= 0: that sub-cell covers [o / K, (o + 1) / K] * step from the voxel centre.
+fn subcell_gap(o: u32, step: f32) -> f32 {
+    return max(f32(o) / f32(P.subcells) * step - (0.5 * step + P.grow), 0.0);
 }
 
 @compute @workgroup_size(8, 8, 1)
 fn pass_x(@builtin(global_invocation_id) gid: vec3u) {
-    if (gid.x >= P.width || gid.y >= P.height || gid.z >= P.slices) { return; }
-    let t = (f32(gid.z) + 0.5) / f32(P.slices);
-    let row = gid.y * P.width;
+    let wk = i32(P.width * P.subcells);
+    let hk = P.height * P.subcells;
+    if (gid.x >= P.width || gid.y >= hk || gid.z >= P.slices) { return; }
+    let bottom = f32(gid.z + 1u) * P.dz + P.grow;
+    let base = i32(gid.x * P.subcells);
+    let row = gid.y * u32(wk);
     var best = 3.0e38;
-    for (var q = 0u; q < P.width; q++) {
-        var gap = src[row + q] - t;
-        if (P.mode == 1u) { gap = -gap; }
-        let v = max(gap, 0.0) * P.sw;
-        let a = max(q, gid.x) - min(q, gid.x);
-        let dx = f32(min(a, P.width - a));
-        best = min(best, dx * dx + v * v);
+    for (var o = 0u; o <= u32(wk) / 2u; o++) {
+        let g = subcell_gap(o, 1.0);
+        if (g * g >= best) { break; }
+        let v0 = max(src[row + u32(wrap_index(base + i32(o), wk))] - bottom, 0.0);
+        let v1 = max(src[row + u32(wrap_index(base - 1 - i32(o), wk))] - bottom, 0.0);
+        best = min(best, g * g + min(v0 * v0, v1 * v1));
     }
-    dst[(gid.z * P.height + gid.y) * P.width + gid.x] = best;
+    dst[(gid.z * hk + gid.y) * P.width + gid.x] = best;
 }
 
 @compute @workgroup_size(8, 8, 1)
 fn pass_y(@builtin(global_invocation_id) gid: vec3u) {
+    let hk = i32(P.height * P.subcells);
     if (gid.x >= P.width || gid.y >= P.height || gid.z >= P.slices) { return; }
-    let base = gid.z * P.height * P.width + gid.x;
+    let base = i32(gid.y * P.subcells);
+    let plane = gid.z * u32(hk) * P.width + gid.x;
     var best = 3.0e38;
-    for (var q = 0u; q < P.height; q++) {
-        let a = max(q, gid.y) - min(q, gid.y);
-        let dy = f32(min(a, P.height - a));
-        best = min(best, dy * dy * P.aspect2 + src[base + q * P.width]);
+    for (var o = 0u; o <= u32(hk) / 2u; o++) {
+        let g = subcell_gap(o, P.sy);
+        if (g * g >= best) { break; }
+        let v0 = src[plane + u32(wrap_index(base + i32(o), hk)) * P.width];
+        let v1 = src[plane + u32(wrap_index(base - 1 - i32(o), hk)) * P.width];
+        best = min(best, g * g + min(v0, v1));
     }
-    var d = sqrt(best);
-    if (P.mode == 1u) { d = max(d - P.subtract, 0.0); }
-    dst[(gid.z * P.height + gid.y) * P.width + gid.x] = d;
+    dst[(gid.z * P.height + gid.y) * P.width + gid.x] = max(sqrt(best) - P.margin, 0.0);
 }

@@ -1,87 +1,116 @@
-// Visibility-refined distance map (seed 000), one invocation per voxel; GPU twin of maptools.distance.refine.
-// Inputs: raw distances to the solid superset S' (dsolid) and to the free-space superset F' (dfree), both exact
-// at the voxel centres (distance.wgsl, pass_y mode 0), and the sampled cone directions (unit, +z = down).
-// For each direction s: forward free path l_s = first L with lower(dS')(c + L s) <= eps + L*alpha (safe steps
-// of the (1 + alpha)-Lipschitz gap), then a backward visibility test: (c, s) is occluded only if some sample
-// c - L s has lower(dF') > eps + L*alpha. Value = max(euclid - eps, min over admissible l_s) - margin, >= 0.
-// Loops: directions <= ndirs, forward <= FORWARD_STEPS, backward <= BACKWARD_SAMPLES.
-// #include "common/border.wgsl"
-
-const FORWARD_STEPS: u32 = 48u;     // = distance.REFINE_FORWARD_STEPS
-const BACKWARD_SAMPLES: u32 = 24u;  // = distance.REFINE_BACKWARD_SAMPLES
+// One azimuth sector of the refined distance map, all its polar bands at once (up to 4, one per vec4 lane), one
+// invocation per voxel (maptools/refined.py: `bake` is the CPU twin, docs/maps.md the argument). The sector's
+// columns come as a list (maptools.refined.entries): sub-cells, cells and windows of cells, each with rho, the
+// least horizontal length towards it within the sector's azimuth wedge (voxel and band independent). Per column,
+// with z0 the drop from the voxel box's bottom to the column top, every ray of band [a, b] from the box reaches it
+// no sooner than
+//     bound(rho, z0) = sqrt(r^2 + max(z0, r cot b)^2),   r = max(rho, z0 tan a),
+// which grows with rho and with z0. Value = max(plain value, least bound - margin), the bound capped at
+// reach / sin b. Cells and windows are sorted by rho: a band is done once rho / sin b (a bound for every later
+// column) reaches its value, or its value is down to the plain one; the walk stops when every band is done. A near
+// cell is a header followed by its sub-cells (sorted by rho): they are looked at only when the whole cell's bound
+// can beat a band's value. Column offsets come pre-wrapped into [0, period).
+//   window_tops: per cell and level L, the top of the window of 2^(L-1) x 2^(L-1) cells (least texel depth) x S*W
+//   main:        src = the stored plain volume, dst = the bands' volumes (band, slice, row, column)
+// #include "common/map_buffers.wgsl"
 
 struct Params {
     width: u32,
     height: u32,
     slices: u32,
-    ndirs: u32,
-    sx: f32,
-    sy: f32,
-    sz: f32,
-    eps: f32,      // half voxel diagonal
-    alpha: f32,    // covering angle of the direction set (radians)
-    margin: f32,   // rounding margin subtracted at the end
-    _pad: vec2f,
+    subcells: u32,      // K
+    count: u32,         // columns in the list
+    levels: u32,        // window levels (window_tops)
+    bands: u32,         // polar bands written (1 to 4)
+    _pad: u32,
+    tan_lo: vec4f,      // per band: tan of its least polar angle
+    cot_hi: vec4f,      // cot of its largest polar angle
+    inv_sin_hi: vec4f,  // 1 / sin of its largest polar angle
+    cap: vec4f,         // reach / sin of its largest polar angle
+    dz: f32,            // metric thickness of one slice
+    grow: f32,          // voxel boxes are grown by this on each side
+    margin: f32,
+    sw: f32,            // S * W (window_tops)
 };
 
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> dsolid: array<f32>;
-@group(0) @binding(2) var<storage, read> dfree: array<f32>;
-@group(0) @binding(3) var<storage, read> dirs: array<vec4f>;
-@group(0) @binding(4) var<storage, read_write> dst: array<f32>;
+struct Column {
+    ox: u32,      // offset from the voxel's own sub-cell (level 0) or cell (level >= 1), modulo the period
+    oy: u32,
+    kind: u32,    // level (0: sub-cell; L: window of 2^(L-1) cells, 1 = a cell) | children << 8 (a header's sub-cells)
+    rho: f32,     // rounded down
+};
 
-// Nearest-voxel lower bound of a 1-Lipschitz field given at voxel centres: value - distance to that centre.
-fn lower_bound(free: bool, p: vec3f) -> f32 {
-    let f = floor(p / vec3f(P.sx, P.sy, P.sz));
-    let fk = clamp(f.z, 0.0, f32(P.slices - 1u));
-    let c = (vec3f(f.x, f.y, fk) + 0.5) * vec3f(P.sx, P.sy, P.sz);
-    let i = wrap_index(i32(f.x), i32(P.width));
-    let j = wrap_index(i32(f.y), i32(P.height));
-    let idx = (u32(fk) * P.height + u32(j)) * P.width + u32(i);
-    var v: f32;
-    if (free) { v = dfree[idx]; } else { v = dsolid[idx]; }
-    return v - length(p - c);
+@group(0) @binding(3) var<storage, read> sub_tops: array<f32>;   // (H K, W K), metric Z of the sub-cell tops
+@group(0) @binding(4) var<storage, read> windows: array<f32>;    // (levels, H, W), from window_tops
+@group(0) @binding(5) var<storage, read> columns: array<Column>;
+
+// x + o for x, o in [0, n): brought back into [0, n).
+fn wrapped(x: u32, o: u32, n: u32) -> u32 {
+    let s = x + o;
+    return select(s, s - n, s >= n);
+}
+
+fn column_top(c: Column, i: u32, j: u32) -> f32 {
+    let level = c.kind & 255u;
+    if (level == 0u) {
+        let wk = P.width * P.subcells;
+        return sub_tops[wrapped(j * P.subcells, c.oy, P.height * P.subcells) * wk + wrapped(i * P.subcells, c.ox, wk)];
+    }
+    return windows[((level - 1u) * P.height + wrapped(j, c.oy, P.height)) * P.width + wrapped(i, c.ox, P.width)];
+}
+
+// The bound of every band for a column rho away whose top is z0 below the box.
+fn bound(rho: f32, z0: f32) -> vec4f {
+    let r = max(vec4f(rho), z0 * P.tan_lo);
+    let depth = max(vec4f(z0), r * P.cot_hi);
+    return sqrt(r * r + depth * depth);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn window_tops(@builtin(global_invocation_id) gid: vec3u) {
+    if (gid.x >= P.width || gid.y >= P.height || gid.z >= P.levels) { return; }
+    let size = 1u << gid.z;
+    var top = 3.0e38;
+    for (var y = 0u; y <= size; y++) {
+        let row = ((gid.y + y) % P.height) * P.width;
+        for (var x = 0u; x <= size; x++) {
+            top = min(top, 1.0 - src[row + (gid.x + x) % P.width]);
+        }
+    }
+    dst[(gid.z * P.height + gid.y) * P.width + gid.x] = top * P.sw;
 }
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     if (gid.x >= P.width || gid.y >= P.height || gid.z >= P.slices) { return; }
-    let out_index = (gid.z * P.height + gid.y) * P.width + gid.x;
-    let euclid = dsolid[out_index];
-    if (euclid <= P.eps) {
-        dst[out_index] = 0.0;
-        return;
-    }
-    let c = (vec3f(gid) + 0.5) * vec3f(P.sx, P.sy, P.sz);
-    let bstep_min = 0.5 * min(P.sx, min(P.sy, P.sz));
-    var best = 3.0e38;
-    var found = false;
-    for (var n = 0u; n < P.ndirs; n++) {
-        let s = dirs[n].xyz;
-        var L = 0.0;
-        for (var step = 0u; step < FORWARD_STEPS; step++) {
-            let g = lower_bound(false, c + L * s) - P.eps - L * P.alpha;
-            if (g <= 0.0 || L >= best) { break; }
-            L += g / (1.0 + P.alpha);
-        }
-        if (L >= best) { continue; }
-        let lend = c.z / s.z;
-        let bstep = max(lend / f32(BACKWARD_SAMPLES), bstep_min);
-        var occluded = false;
-        for (var q = 1u; q <= BACKWARD_SAMPLES; q++) {
-            let lb = f32(q) * bstep;
-            if (lb > lend) { break; }
-            if (lower_bound(true, c - lb * s) > P.eps + lb * P.alpha) {
-                occluded = true;
-                break;
+    let index = (gid.z * P.height + gid.y) * P.width + gid.x;
+    let plain = vec4f(src[index]);
+    let bottom = f32(gid.z + 1u) * P.dz + P.grow;
+    // lanes past `bands` start done: their value is the cap, and nothing is written for them
+    let unused = vec4<bool>(P.bands < 1u, P.bands < 2u, P.bands < 3u, P.bands < 4u);
+    var best = P.cap;
+    var done = unused | (best <= plain);
+    for (var q = 0u; q < P.count;) {
+        let c = columns[q];
+        done = done | (vec4f(c.rho) * P.inv_sin_hi >= best) | (best <= plain);
+        if (all(done)) { break; }
+        let b = bound(c.rho, max(column_top(c, gid.x, gid.y) - bottom, 0.0));
+        let children = c.kind >> 8u;
+        if (children == 0u) {
+            best = select(min(best, b), best, done);
+        } else if (any((b < best) & !done)) {
+            for (var s = q + 1u; s <= q + children; s++) {
+                let d = columns[s];
+                let open = !done & (vec4f(d.rho) * P.inv_sin_hi < best) & (best > plain);
+                if (!any(open)) { break; }
+                best = select(best, min(best, bound(d.rho, max(column_top(d, gid.x, gid.y) - bottom, 0.0))), open);
             }
         }
-        if (!occluded) {
-            best = L;
-            found = true;
-        }
+        q += 1u + children;
     }
-    var v = euclid - P.eps;
-    if (found) { v = max(v, best); }
-    dst[out_index] = max(v - P.margin, 0.0);
+    let value = max(plain, best - P.margin);
+    let volume = P.slices * P.height * P.width;
+    for (var band = 0u; band < P.bands; band++) {
+        dst[band * volume + index] = value[band];
+    }
 }

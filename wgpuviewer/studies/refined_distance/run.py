@@ -1,0 +1,205 @@
+"""``wgpuviewer refined-distance``: fetches per pixel of the distance tracer on every distance-map variant, on the
+benchmark's full-screen views (wgpuviewer.bench.view), mean and SIMD-tile (``accuracy.simd_tile_cost``), with the
+build time and memory of each map. Variants no technique binds are traced by the numpy twin of the tracer
+(tracer.py); the two registered techniques also by the GPU renderer, side by side, as the check.
+"""
+
+from __future__ import annotations
+
+import csv
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from maptools.cache import cached_generate
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.io import write_bytes
+from wgpuviewer.relief.accuracy import simd_tile_cost
+from wgpuviewer.relief.maps import DISTANCE_SLICES
+from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
+
+from .baseline import plain_before
+from .tracer import trace
+
+#: The baseline's kind: not a maptools kind, built by baseline.plain_before (uncached: seconds).
+BEFORE = "maptools-2 plain"
+
+
+@dataclass(frozen=True)
+class Variant:
+    name: str
+    kind: str  # maptools kind
+    options: dict  # beyond slices and height_scale
+    technique: str = ""  # the registered technique that renders exactly this map, if any
+
+    def bins(self) -> dict:
+        """The tracer's view of the map: sectors, bands and max_angle (refined kind) or nothing (plain)."""
+        if self.kind != "distance_refined":
+            return {}
+        return {"sectors": self.options["sectors"], "bands": self.options["bands"], "max_angle": REFINED_MAX_ANGLE}
+
+
+def _refined(sectors: int, bands: int, technique: str = "") -> Variant:
+    name = "single cone" if sectors == bands == 1 else f"{sectors} sectors x {bands} bands"
+    return Variant(name, "distance_refined", {"sectors": sectors, "bands": bands}, technique)
+
+
+VARIANTS = (
+    Variant("plain before (maptools-2)", BEFORE, {}),
+    Variant("plain K=1", "distance", {"subcells": 1}),
+    Variant("plain K=4", "distance", {"subcells": 4}, "distance"),
+    _refined(1, 1),
+    _refined(8, 1),
+    _refined(1, REFINED_BANDS),
+    _refined(2, REFINED_BANDS),
+    _refined(REFINED_SECTORS, REFINED_BANDS, "distance_refined"),
+)
+PRODUCT = VARIANTS[-1].name
+
+
+@dataclass(frozen=True)
+class Suite:
+    heightmaps: tuple[str, ...]
+    angles: tuple[float, ...]
+    resolution: tuple[int, int]
+    builtin_size: int
+
+
+SUITES = {
+    "smoke": Suite(("bricks", "wall"), (45.0, 80.0), (32, 16), 32),
+    "full": Suite(("brick", "grass", "gravel", "bricks", "bumps", "ridges", "wall"), (0.0, 30.0, 45.0, 60.0, 75.0, 80.0),
+                  (256, 144), 256),
+}
+
+COLUMNS = ("heightmap", "size", "angle", "variant", "tracer", "fetches_mean", "fetches_simd", "capped", "build_s",
+           "memory_mib")
+
+
+def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[np.ndarray, float]:
+    t0 = time.perf_counter()
+    if variant.kind == BEFORE:
+        out = plain_before(height, slices=DISTANCE_SLICES, height_scale=height_scale)
+        return out, time.perf_counter() - t0
+    out = cached_generate(variant.kind, height, backend="auto", slices=DISTANCE_SLICES, height_scale=height_scale,
+                          **variant.options)
+    return out, time.perf_counter() - t0
+
+
+def run(suite_name: str, out: Path, heightmaps=None, angles=None, progress: bool = True) -> list[dict]:
+    """Measure every variant of ``SUITES[suite_name]``; write ``out``/results.csv and report.md; return the rows."""
+    from tqdm import tqdm
+
+    from wgpuviewer.bench.run import REAL_MAPS, skimage_available
+    from wgpuviewer.bench.view import HEIGHT_SCALE, load_heightmap, make_view
+    from wgpuviewer.core.gpu import get_gpu
+    from wgpuviewer.relief.renderer import DrawConfig, Renderer
+
+    if suite_name not in SUITES:
+        raise UserError(f"--suite {suite_name!r}: unknown; expected one of {', '.join(SUITES)}")
+    suite = SUITES[suite_name]
+    maps = tuple(heightmaps or suite.heightmaps)
+    if heightmaps is None and not skimage_available():
+        maps = tuple(m for m in maps if m not in REAL_MAPS)
+    gpu = get_gpu(None, quiet=True)
+    rows: list[dict] = []
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="wgpuviewer-refined-") as workdir, \
+            tqdm(total=len(maps) * len(VARIANTS), desc="refined-distance", unit="map", disable=not progress) as bar:
+        for name in maps:
+            try:
+                heightmap = load_heightmap(name, suite.builtin_size, Path(workdir))
+            except KeyError:
+                raise UserError(f"--heightmaps: unknown height map {name!r}") from None
+            depth = 1.0 - heightmap.height.astype(np.float64)
+            views = [make_view(heightmap, a, suite.resolution) for a in (angles or suite.angles)]
+            for variant in VARIANTS:
+                volumes, seconds = _build(variant, heightmap.height, HEIGHT_SCALE)
+                for view in views:
+                    covered = np.ones(view.uv0.shape[:2], bool)
+                    got = trace(depth, volumes, view.uv0.reshape(-1, 2), view.v_ts.reshape(-1, 3), HEIGHT_SCALE,
+                                **variant.bins())
+                    rows.append(_row(heightmap, view, variant, "numpy twin", got.fetches.reshape(covered.shape),
+                                     covered, got.capped, seconds, volumes))
+                    if variant.technique:
+                        image = Renderer(view.scene, gpu).render(DrawConfig.of(variant.technique), suite.resolution)
+                        raw = image.data[:, :, 3]
+                        fetches = np.where(raw < 0, -raw - 1.0, raw)
+                        rows.append(_row(heightmap, view, variant, f"GPU ({gpu.summary})", fetches, image.covered,
+                                         raw[image.covered] < 0, seconds, volumes))
+                bar.update()
+            _write(out, rows)
+    return rows
+
+
+def _row(heightmap, view, variant, tracer, fetches, covered, capped, seconds, volumes) -> dict:
+    return {"heightmap": heightmap.name, "size": f"{heightmap.size[0]}x{heightmap.size[1]}", "angle": view.angle,
+            "variant": variant.name, "tracer": tracer,
+            "fetches_mean": float(np.mean(fetches[covered])), "fetches_simd": simd_tile_cost(fetches, covered=covered),
+            "capped": float(np.mean(capped)), "build_s": seconds, "memory_mib": volumes.nbytes / 2**20}
+
+
+def _write(out: Path, rows: list[dict]) -> None:
+    text = _csv(rows)
+    write_bytes(out / "results.csv", text.encode())
+    write_bytes(out / "report.md", report(rows).encode())
+
+
+def _csv(rows: list[dict]) -> str:
+    import io
+
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=COLUMNS)
+    writer.writeheader()
+    writer.writerows(rows)
+    return buf.getvalue()
+
+
+#: The report's change columns: (label, variant, against which variant).
+CHANGES = (("K=4 vs before", "plain K=4", VARIANTS[0].name), ("product vs before", PRODUCT, VARIANTS[0].name),
+           ("product vs K=4", PRODUCT, "plain K=4"))
+
+
+def _change(by: dict, variant: str, base: str) -> str:
+    a, b = by.get(variant), by.get(base)
+    if not (a and b):
+        return "-"
+    return (f"{100 * (a['fetches_mean'] / b['fetches_mean'] - 1):+.0f} % / "
+            f"{100 * (a['fetches_simd'] / b['fetches_simd'] - 1):+.0f} %")
+
+
+def report(rows: list[dict]) -> str:
+    """Markdown: per height map, fetches per pixel mean / SIMD-tile by angle (rows) and variant (columns), the changes
+    of the new plain map and of the product's refined map against the map before issue 12 and against each other,
+    build times and memory."""
+    lines = ["# Distance-map variants: fetches per pixel (mean / SIMD-tile 8x4)", "",
+             "Every fetch to the final hit (volume fetches and exact-cell gathers), the same tracer for every map. "
+             "Changes: mean / SIMD-tile.", ""]
+    variants = [v.name for v in VARIANTS]
+    for name in dict.fromkeys(r["heightmap"] for r in rows):
+        mine = [r for r in rows if r["heightmap"] == name and r["tracer"] == "numpy twin"]
+        if not mine:
+            continue
+        lines += [f"## {name} ({mine[0]['size']})", "",
+                  "| angle | " + " | ".join(variants + [c[0] for c in CHANGES]) + " |",
+                  "|---|" + "---|" * (len(variants) + len(CHANGES))]
+        for angle in dict.fromkeys(r["angle"] for r in mine):
+            cells, by = [], {r["variant"]: r for r in mine if r["angle"] == angle}
+            for v in variants:
+                r = by.get(v)
+                cells.append(f"{r['fetches_mean']:.2f} / {r['fetches_simd']:.2f}" if r else "-")
+            cells += [_change(by, variant, base) for _, variant, base in CHANGES]
+            lines.append(f"| {angle:g}° | " + " | ".join(cells) + " |")
+        builds = {r["variant"]: r for r in mine}
+        lines += ["", "build (s, cache included) and memory (MiB): " + "; ".join(
+            f"{v}: {builds[v]['build_s']:.1f} s, {builds[v]['memory_mib']:.1f} MiB" for v in variants if v in builds),
+            ""]
+        gpu = [r for r in rows if r["heightmap"] == name and r["tracer"] != "numpy twin"]
+        if gpu:
+            lines.append(f"GPU renderer ({gpu[0]['tracer']}), same views: " + "; ".join(
+                f"{r['variant']} {r['angle']:g}° {r['fetches_mean']:.2f} / {r['fetches_simd']:.2f}" for r in gpu))
+            lines.append("")
+    return "\n".join(lines) + "\n"
