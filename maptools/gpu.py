@@ -77,7 +77,8 @@ class MapGpu:
             arr[i] = np.float32(v).view(np.uint32) if isinstance(v, float) else np.uint32(v)
         return self.device.create_buffer_with_data(label=label, data=arr, usage=wgpu.BufferUsage.UNIFORM)
 
-    def dispatch(self, encoder, file: str, entry: str, bindings: dict, w: int, h: int) -> None:
+    def dispatch(self, encoder, file: str, entry: str, bindings: dict, w: int, h: int, d: int = 1) -> None:
+        """One compute pass: ``entry`` of ``file`` over w x h (x d, one workgroup layer per slice) invocations."""
         pipe = self.pipeline(file, entry)
         group = self.device.create_bind_group(
             label=f"maptools {file}:{entry}", layout=pipe.get_bind_group_layout(0),
@@ -85,7 +86,7 @@ class MapGpu:
         cp = encoder.begin_compute_pass(label=f"maptools {file}:{entry}")
         cp.set_pipeline(pipe)
         cp.set_bind_group(0, group)
-        cp.dispatch_workgroups((w + _WG - 1) // _WG, (h + _WG - 1) // _WG, 1)
+        cp.dispatch_workgroups((w + _WG - 1) // _WG, (h + _WG - 1) // _WG, d)
         cp.end()
 
     def submit(self, encoder, what: str) -> None:
@@ -189,18 +190,6 @@ def maxmip(g: MapGpu, height: np.ndarray):
 
 # -- 3D distance maps ------------------------------------------------------------------------------------
 
-def _dispatch3(g: MapGpu, encoder, file: str, entry: str, bindings: dict, w: int, h: int, d: int) -> None:
-    pipe = g.pipeline(file, entry)
-    group = g.device.create_bind_group(
-        label=f"maptools {file}:{entry}", layout=pipe.get_bind_group_layout(0),
-        entries=[{"binding": b, "resource": {"buffer": buf}} for b, buf in bindings.items()])
-    cp = encoder.begin_compute_pass(label=f"maptools {file}:{entry}")
-    cp.set_pipeline(pipe)
-    cp.set_bind_group(0, group)
-    cp.dispatch_workgroups((w + _WG - 1) // _WG, (h + _WG - 1) // _WG, d)
-    cp.end()
-
-
 def _check_volume(g: MapGpu, w: int, h: int, slices: int, subcells: int, volumes: int = 1) -> None:
     g.check_size(h, w)
     need = w * h * slices * 4 * volumes
@@ -222,9 +211,9 @@ def _plain_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale
     tops = g.storage(w * h * k * k * 4, f"maptools {label} sub-cell tops")
     rows = g.storage(w * h * k * slices * 4, f"maptools {label} row pass")
     out = g.storage(w * h * slices * 4, f"maptools {label} volume")
-    _dispatch3(g, enc, "distance.wgsl", "tops", {0: params, 1: src, 2: tops}, w * k, h * k, 1)
-    _dispatch3(g, enc, "distance.wgsl", "pass_x", {0: params, 1: tops, 2: rows}, w, h * k, slices)
-    _dispatch3(g, enc, "distance.wgsl", "pass_y", {0: params, 1: rows, 2: out}, w, h, slices)
+    g.dispatch(enc, "distance.wgsl", "tops", {0: params, 1: src, 2: tops}, w * k, h * k, 1)
+    g.dispatch(enc, "distance.wgsl", "pass_x", {0: params, 1: tops, 2: rows}, w, h * k, slices)
+    g.dispatch(enc, "distance.wgsl", "pass_y", {0: params, 1: rows, 2: out}, w, h, slices)
     return out, tops, params
 
 
@@ -285,8 +274,8 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
         cbuf = g.storage(lists[sector].packed(w, h, subcells), "maptools distance_refined columns")
         enc = g.encoder("maptools distance_refined pass")
         if number == 0:
-            _dispatch3(g, enc, "distance_refined.wgsl", "window_tops", {0: p, 1: src, 2: windows}, w, h, levels)
-        _dispatch3(g, enc, "distance_refined.wgsl", "main",
+            g.dispatch(enc, "distance_refined.wgsl", "window_tops", {0: p, 1: src, 2: windows}, w, h, levels)
+        g.dispatch(enc, "distance_refined.wgsl", "main",
                    {0: p, 1: plain, 2: vol, 3: sub_tops, 4: windows, 5: cbuf}, w, h, slices)
         g.submit(enc, "distance_refined pass")
         result = dist.round_down(g.read(vol, len(group) * n).astype(np.float64), np.float16)

@@ -287,7 +287,7 @@ def cmd_refined_distance(args) -> int:
         raise UserError(f"--angles {args.angles!r}: expected degrees from 0 to 85")
     heightmaps = names(args.heightmaps, "--heightmaps")
     out = output_dir(args.out, "--out")
-    run(args.suite, out, heightmaps=heightmaps, angles=angles, progress=not args.quiet)
+    run(args.suite, out, heightmaps=heightmaps, angles=angles, backend=args.backend, progress=not args.quiet)
     print(out / "report.md")
     return 0
 
@@ -308,6 +308,19 @@ def add_filter_options(parser) -> None:
     parser.add_argument("--derivatives", default=DEFAULT_DERIVATIVES,
                         help=f"derivative source the filter's footprint comes from: uv, displaced, analytic "
                         f"(default {DEFAULT_DERIVATIVES})")
+
+
+def measurement_parser(sub, name: str, help: str, out_help: str, suite_help: str, backend_help: str):
+    """A measuring command's parser (bench and the studies) with the options they share: --out, --suite, --backend,
+    --quiet; the caller adds its own."""
+    from wgpuviewer.core.gpu import BACKEND_CHOICES
+
+    parser = sub.add_parser(name, help=help)
+    parser.add_argument("--out", required=True, help=out_help)
+    parser.add_argument("--suite", choices=("smoke", "full"), default="full", help=suite_help)
+    parser.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    return parser
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -359,37 +372,31 @@ def build_parser() -> argparse.ArgumentParser:
     accuracy.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     accuracy.set_defaults(func=cmd_accuracy)
 
-    bench = sub.add_parser("bench", help="speed against error of every technique (results.csv, report.md, plots)")
-    bench.add_argument("--out", required=True, help="output folder (results.csv, report.md, *.png)")
-    bench.add_argument("--suite", choices=("smoke", "full"), default="full",
-                       help="full: real GPUs (1920x1080, all maps and angles); smoke: minutes on a software adapter")
+    bench = measurement_parser(
+        sub, "bench", "speed against error of every technique (results.csv, report.md, plots)",
+        "output folder (results.csv, report.md, *.png)",
+        "full: real GPUs (1920x1080, all maps and angles); smoke: minutes on a software adapter", backend_help)
     bench.add_argument("--resolution", help="frame WIDTHxHEIGHT (default: the suite's; full: 1920x1080)")
     bench.add_argument("--heightmaps", help="comma-separated: builtins and/or scikit-image brick,grass,gravel")
     bench.add_argument("--techniques", help="comma-separated technique names (default: all registered)")
     bench.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 89)")
     bench.add_argument("--frames", type=int, help="timed frames per configuration (median; default: the suite's)")
-    bench.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
     bench.add_argument("--simd-tile", help="WIDTHxHEIGHT pixels of the SIMD group for the fetches_simd cost (default 8x4)")
-    bench.add_argument("--quiet", action="store_true", help="no progress bar")
     bench.add_argument("--from-csv", nargs="+", metavar="CSV",
                        help="measure nothing: write report.md and plots from these results.csv files into --out")
     bench.set_defaults(func=cmd_bench)
 
-    perspective = sub.add_parser("perspective", help="perspective-correct texturing study (seed 001): speed and "
-                                 "float error of Heckbert's direct, incremental and parallel forms")
-    perspective.add_argument("--out", required=True, help="output folder (results.csv, report.md, *.png)")
-    perspective.add_argument("--suite", choices=("smoke", "full"), default="full",
-                             help="full: every sweep, 4K frames (minutes on a software adapter); smoke: seconds, for CI")
-    perspective.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
-    perspective.add_argument("--quiet", action="store_true", help="no progress bar")
+    perspective = measurement_parser(
+        sub, "perspective", "perspective-correct texturing study (seed 001): speed and float error of Heckbert's "
+        "direct, incremental and parallel forms", "output folder (results.csv, report.md, *.png)",
+        "full: every sweep, 4K frames (minutes on a software adapter); smoke: seconds, for CI", backend_help)
     perspective.set_defaults(func=cmd_perspective)
 
-    filtering = sub.add_parser("filtering", help="texture filters on relief against a supersampled reference "
-                               "(results.csv, report.md, pareto.png, crops)")
-    filtering.add_argument("--out", required=True, help="output folder")
-    filtering.add_argument("--suite", choices=("smoke", "full"), default="full",
-                           help="full: every filter x derivative source on 150 cases (real GPUs); smoke: 3 cases, "
-                           "under 2 minutes on a software adapter")
+    filtering = measurement_parser(
+        sub, "filtering", "texture filters on relief against a supersampled reference (results.csv, report.md, "
+        "pareto.png, crops)", "output folder",
+        "full: every filter x derivative source on 150 cases (real GPUs); smoke: 3 cases, under 2 minutes on a "
+        "software adapter", backend_help)
     filtering.add_argument("--size", help="frame WIDTHxHEIGHT (default: the suite's)")
     filtering.add_argument("--frames", type=int, help="timed frames per configuration (median)")
     filtering.add_argument("--reliefs", help="comma-separated: bricks, step, wall, flat0")
@@ -397,18 +404,14 @@ def build_parser() -> argparse.ArgumentParser:
     filtering.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 86)")
     filtering.add_argument("--footprints", help="comma-separated texels per pixel at the frame centre, e.g. 1,4")
     filtering.add_argument("--filters", help="comma-separated filter names (trilinear, the baseline, always runs)")
-    filtering.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
-    filtering.add_argument("--quiet", action="store_true", help="no progress bar")
     filtering.set_defaults(func=cmd_filtering)
 
-    refined = sub.add_parser("refined-distance", help="fetches of the distance tracer on every distance-map "
-                             "variant, on the benchmark's views (results.csv, report.md)")
-    refined.add_argument("--out", required=True, help="output folder (results.csv, report.md)")
-    refined.add_argument("--suite", choices=("smoke", "full"), default="full",
-                         help="smoke: two small maps, two angles; full: the benchmark's real maps and wall, 0-80 degrees")
+    refined = measurement_parser(
+        sub, "refined-distance", "fetches of the distance tracer on every distance-map variant (seed 000), on the "
+        "benchmark's views (results.csv, report.md)", "output folder (results.csv, report.md)",
+        "smoke: two small maps, two angles; full: the benchmark's real maps and wall, 0-80 degrees", backend_help)
     refined.add_argument("--heightmaps", help="comma-separated: builtins and/or scikit-image brick,grass,gravel")
     refined.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 85)")
-    refined.add_argument("--quiet", action="store_true", help="no progress bar")
     refined.set_defaults(func=cmd_refined_distance)
 
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")

@@ -88,7 +88,8 @@ def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[n
     return out, time.perf_counter() - t0
 
 
-def run(suite_name: str, out: Path, heightmaps=None, angles=None, progress: bool = True) -> list[dict]:
+def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str | None = None,
+        progress: bool = True) -> list[dict]:
     """Measure every variant of ``SUITES[suite_name]``; write ``out``/results.csv and report.md; return the rows."""
     from tqdm import tqdm
 
@@ -103,7 +104,7 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, progress: bool
     maps = tuple(heightmaps or suite.heightmaps)
     if heightmaps is None and not skimage_available():
         maps = tuple(m for m in maps if m not in REAL_MAPS)
-    gpu = get_gpu(None, quiet=True)
+    gpu = get_gpu(backend, quiet=True)
     rows: list[dict] = []
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
