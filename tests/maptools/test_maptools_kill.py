@@ -24,7 +24,7 @@ def test_sigkill_mid_batch_leaves_only_complete_outputs(tmp_path, capsys):
     src.mkdir()
     maps = {}
     for n in range(40):
-        maps[f"h{n:02d}"] = rng.random((256, 256)).astype(np.float32)
+        maps[f"h{n:02d}"] = rng.random((128, 128)).astype(np.float32)
         np.save(src / f"h{n:02d}.npy", maps[f"h{n:02d}"])
     out = tmp_path / "out"
     argv = [sys.executable, "-c", "import sys; from maptools.cli import main; sys.exit(main())", "batch", str(src),
@@ -60,7 +60,7 @@ def test_sigkill_mid_batch_leaves_only_complete_outputs(tmp_path, capsys):
             import cv2
 
             img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
-            assert img is not None and img.shape == (256, 256, 3)
+            assert img is not None and img.shape == (128, 128, 3)
         else:
             want = maptools.generate(kind, maps[stem], backend="cpu", slices=24)
             assert np.array_equal(np.load(p), want)

@@ -141,12 +141,14 @@ def test_exact_tracers_find_the_first_hit(gpu, technique, name):
 @pytest.mark.parametrize("technique", EXACT)
 def test_exact_tracers_on_npot_and_single_texel_maps(gpu, technique):
     h = npot_height()
+    if technique == "distance_refined":  # still NPOT and non-square; the full map's 33-volume bake is 90 s on lavapipe
+        h = h[:131, :97]
     uv, view = random_rays(1024, 70, seed=9)
     got = probe(technique, h, uv, view, 0.05)
     ref = exact_hit(1.0 - h, uv, view, 0.05)
     assert not got.capped.any()
     assert (got.depth <= ref.t + T_TOL).all()
-    assert uv_error_texels(got.uv, ref.uv, (343, 401)).max() <= 0.01
+    assert uv_error_texels(got.uv, ref.uv, (h.shape[1], h.shape[0])).max() <= 0.01
     one = probe(technique, np.full((1, 1), 0.25), uv, view, 0.1)
     assert np.allclose(one.depth, 0.75, atol=1e-5) and not one.capped.any()
 

@@ -69,13 +69,14 @@ class Suite:
     sweeps: dict = field(default_factory=dict)
     eval_pixels: int = 65536  # pixels per measurement compared with the reference
     builtin_size: int = 256
+    real_size: int = 0  # scikit-image maps area-downscaled to at most this many texels per side (0: as bundled)
     simd_tile: tuple[int, int] = (8, 4)  # (width, height) pixels of the SIMD group in fetches_simd
     reference_workers: int = 0  # processes for the float64 reference hits (0: in this process)
 
 
 SUITES = {
     "smoke": Suite("smoke", ("brick", "bricks", "spike"), (0.0, 45.0, 60.0, 80.0, 89.0), (96, 54), 30, 3,
-                   SMOKE_SWEEPS, eval_pixels=1500, builtin_size=128),
+                   SMOKE_SWEEPS, eval_pixels=1500, builtin_size=128, real_size=256),
     # 20 frames after 2 warm-up rounds: the whole suite in one 8-minute run on an H100-class GPU (docs/benchmarks.md)
     "full": Suite("full", REAL_MAPS + SYNTHETIC_MAPS, ALL_ANGLES, (1920, 1080), 20, 2, SWEEPS,
                   eval_pixels=32768, builtin_size=256, reference_workers=-1),
@@ -313,7 +314,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
         work = []  # (heightmap, views, the renderer whose maps and pipelines its views share, map bytes per technique)
         for map_name in suite.heightmaps:
             try:
-                heightmap = load_heightmap(map_name, suite.builtin_size, Path(workdir))
+                heightmap = load_heightmap(map_name, suite.builtin_size, Path(workdir), suite.real_size)
             except Exception as e:  # noqa: BLE001 - e.g. scikit-image's data not loadable offline
                 options.notes.append(f"height map {map_name!r} left out: {type(e).__name__}: {e}")
                 bar.update(len(suite.angles) * len(configs))

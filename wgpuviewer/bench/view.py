@@ -59,9 +59,10 @@ class HeightMap:
 SKIMAGE_MAPS = ("brick", "grass", "gravel")
 
 
-def load_heightmap(name: str, builtin_size: int, workdir: Path) -> HeightMap:
+def load_heightmap(name: str, builtin_size: int, workdir: Path, real_size: int = 0) -> HeightMap:
     """A builtin (textures.BUILTINS) at ``builtin_size``², or a scikit-image texture (8-bit grey,
-    brighter = higher, also used as the albedo) written to ``workdir`` as PNG."""
+    brighter = higher, also used as the albedo) written to ``workdir`` as PNG, area-downscaled to at most
+    ``real_size`` texels per side when that is given (0: as bundled)."""
     if name in textures.BUILTINS:
         size = (builtin_size, builtin_size)
         texture = f'{{ builtin = "{name}", size = [{size[0]}, {size[1]}] }}'
@@ -71,12 +72,17 @@ def load_heightmap(name: str, builtin_size: int, workdir: Path) -> HeightMap:
         import skimage.data
 
         grey = np.asarray(getattr(skimage.data, name)(), np.uint8)
-        path = Path(workdir) / f"skimage_{name}.png"
+        origin = f"skimage.data.{name}() {grey.shape[1]}x{grey.shape[0]} (scikit-image)"
+        if real_size and max(grey.shape) > real_size:
+            scale = real_size / max(grey.shape)
+            size = (round(grey.shape[1] * scale), round(grey.shape[0] * scale))
+            grey = cv2.resize(grey, size, interpolation=cv2.INTER_AREA)
+            origin += f", downscaled to {size[0]}x{size[1]}"
+        path = Path(workdir) / f"skimage_{name}_{grey.shape[1]}x{grey.shape[0]}.png"
         if not path.exists():
             cv2.imwrite(str(path), grey)
         height = grey.astype(np.float32) / 255.0
-        return HeightMap(name, height, _toml_string(str(path)),
-                         f"skimage.data.{name}() {grey.shape[1]}x{grey.shape[0]} (scikit-image)")
+        return HeightMap(name, height, _toml_string(str(path)), origin)
     raise KeyError(name)
 
 
