@@ -235,7 +235,7 @@ def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: f
 
 @_guard
 def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05,
-                     subcells: int = 4, max_angle: float = 80.0, sectors: int = 4, bands: int = 8,
+                     subcells: int = 4, max_angle: float = 85.0, sectors: int = 4, bands: int = 8,
                      reach: float = 16.0, progress: bool = True):
     """GPU twin of refined.distance_refined: the plain volume (distance.wgsl), then one dispatch of
     distance_refined.wgsl per direction bin, each read back and rounded down to float16."""

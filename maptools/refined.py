@@ -305,7 +305,7 @@ def check(w: int, h: int, slices: int, sectors: int, bands: int, kind: str = "di
 
 
 def distance_refined(height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05, subcells: int = 4,
-                     max_angle: float = 80.0, sectors: int = 4, bands: int = 8, reach: float = 16.0,
+                     max_angle: float = 85.0, sectors: int = 4, bands: int = 8, reach: float = 16.0,
                      progress: bool = True) -> np.ndarray:
     """Direction-binned refined volumes, float16 (V, Dz, H, W) rounded down: volume band * sectors + sector for
     the rays of that bin, the last one the plain map (rays steeper than max_angle)."""

@@ -227,7 +227,7 @@ KINDS: dict[str, Kind] = {
                     "volume per bin of ray directions (azimuth sectors x polar bands of the view cone) with a safe "
                     "step for every ray of that bin, then the plain map (steeper rays); nearest lookups",
         options=_VOLUME_OPTIONS + (
-            Option("max_angle", 80.0, float, "half-angle of the binned view cone, degrees from the normal",
+            Option("max_angle", 85.0, float, "half-angle of the binned view cone, degrees from the normal",
                    lo=1.0, hi=89.0),
             Option("sectors", 4, int, "azimuth sectors (with bands 1: 1 = the single cone of the paper)",
                    choices=rf.SECTOR_CHOICES),

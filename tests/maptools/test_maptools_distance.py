@@ -294,7 +294,7 @@ def test_sphere_tracing_never_tunnels(name, s, slices):
     rng = np.random.default_rng(len(name))
     plain = maptools.generate("distance", h, backend="cpu", slices=slices, height_scale=s)
     refined = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s, sectors=8,
-                                bands=BANDS, reach=8.0)
+                                bands=BANDS, reach=8.0, max_angle=80.0)
     uv, v = cone_rays(1500, 89.0, rng)
     uv2, v2 = adversarial_rays(120, h.shape, np.degrees(rf.band_edges(BANDS, 80.0)), 8, rng)
     uv, v = np.concatenate([uv, uv2]), np.concatenate([v, v2])
@@ -328,7 +328,7 @@ def test_refined_value_never_exceeds_the_free_path(name):
     rows, cols = h.shape
     slices, s = 8, 0.4
     vol = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s, sectors=8,
-                            bands=BANDS, reach=8.0).astype(np.float64)
+                            bands=BANDS, reach=8.0, max_angle=80.0).astype(np.float64)
     depth = 1.0 - h.astype(np.float64)
     rng = np.random.default_rng(3)
     n = 20000

@@ -215,7 +215,7 @@ def test_distance_refined_fetches_against_plain(gpu):
     """Both exact; the refined map takes fewer fetches inside its cone, the more the steeper, and beyond it the plain
     volume's (stored as float16, rounded down: a hair shorter steps)."""
     h = height_map("bricks")
-    for angle, most in ((30, 0.995), (60, 0.95), (80, 0.8), (85, 1.01)):
+    for angle, most in ((30, 0.995), (60, 0.95), (80, 0.8), (87, 1.01)):
         plain = measure("distance", h, angle, rays=1024)
         refined = measure("distance_refined", h, angle, rays=1024)
         assert plain.error_p95 <= 0.01 and refined.error_p95 <= 0.01

@@ -24,7 +24,7 @@ def test_twin_takes_the_gpu_tracers_steps(gpu, name):
     depth = 1.0 - h
     plain = cached_generate("distance", h, backend="auto", slices=DISTANCE_SLICES, height_scale=0.05)
     refined = cached_generate("distance_refined", h, backend="auto", slices=DISTANCE_SLICES, height_scale=0.05,
-                              sectors=REFINED_SECTORS, bands=REFINED_BANDS)
+                              sectors=REFINED_SECTORS, bands=REFINED_BANDS, max_angle=REFINED_MAX_ANGLE)
     bins = {"sectors": REFINED_SECTORS, "bands": REFINED_BANDS, "max_angle": REFINED_MAX_ANGLE}
     for angle in (0.0, 33.0, 55.0, 73.0, 79.0, 84.0):  # off the band edges: float32 and float64 pick the same one
         uv, v = random_rays(1024, angle, seed=int(angle))
