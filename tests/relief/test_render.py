@@ -127,6 +127,23 @@ def test_resources_follow_the_selected_technique(gpu):
     assert new == [f"pipeline:steep:{OFFSCREEN}"]  # steep reuses every texture
 
 
+def test_distance_builds_only_the_plain_map_and_the_refined_one_when_selected(gpu, tmp_path):
+    """Model only what a scene needs: `distance` builds the plain volume alone; the refined volumes come with
+    `distance_refined` (which reuses the depth map)."""
+    from .scenes import plane_scene
+
+    path = tmp_path / "scene.toml"
+    path.write_text(plane_scene("distance").replace('techniques = ["distance"]',
+                                                    'techniques = ["distance", "distance_refined"]'))
+    renderer = Renderer(load_scene(path), gpu)
+    renderer.render("distance", (32, 32))
+    built = [c for c in renderer.created if c.startswith("texture:")]
+    assert "texture:m.distance" in built and "texture:m.distance_refined" not in built
+    before = len(renderer.created)
+    renderer.render("distance_refined", (32, 32))
+    assert [c for c in renderer.created[before:] if c.startswith("texture:")] == ["texture:m.distance_refined"]
+
+
 def test_grazing_camera_renders_finite(gpu):
     """A camera almost in the plane: every traced value stays finite."""
     from dataclasses import replace
