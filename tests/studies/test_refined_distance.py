@@ -55,6 +55,7 @@ def test_smoke_suite(tmp_path, gpu):
     text = (tmp_path / "report.md").read_text()
     assert text == report(rows) and "## bricks" in text and "product vs before" in text
     assert (tmp_path / "results.csv").read_text().startswith("heightmap,size,angle,variant")
+    assert (tmp_path / "fetches_vs_angle.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_cli_rejects_bad_options(tmp_path, capsys):

@@ -147,6 +147,57 @@ def _write(out: Path, rows: list[dict]) -> None:
     text = _csv(rows)
     write_bytes(out / "results.csv", text.encode())
     write_bytes(out / "report.md", report(rows).encode())
+    plot(rows, out / PLOT)
+
+
+#: The picture of the report: fetches per pixel against the view angle, one panel per height map.
+PLOT = "fetches_vs_angle.png"
+
+
+def plot(rows: list[dict], path: Path) -> bool:
+    """Mean fetches per pixel (solid) and SIMD-tile fetches (dotted) against the view angle, one line per variant
+    and one panel per height map (numpy-twin rows). False when matplotlib is missing (the tables still stand)."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return False
+    import io
+    import math
+
+    twins = [r for r in rows if r["tracer"] == "numpy twin"]
+    maps = list(dict.fromkeys(r["heightmap"] for r in twins))
+    cols = min(4, len(maps)) or 1
+    fig, axes = plt.subplots(math.ceil(len(maps) / cols) or 1, cols, figsize=(3.6 * cols, 3.0 * math.ceil(len(maps) / cols)),
+                             squeeze=False)
+    for ax, name in zip(axes.ravel(), maps):
+        for i, variant in enumerate(v.name for v in VARIANTS):
+            mine = sorted((float(r["angle"]), float(r["fetches_mean"]), float(r["fetches_simd"]))
+                          for r in twins if r["heightmap"] == name and r["variant"] == variant)
+            if not mine:
+                continue
+            angles, mean, simd = zip(*mine)
+            color = plt.cm.tab10(i % 10)
+            ax.plot(angles, mean, "-o", ms=2.5, lw=1.2 if variant != PRODUCT else 2.2, color=color, label=variant)
+            ax.plot(angles, simd, ":", lw=0.8, color=color)
+        ax.set_title(f"{name} ({next(r['size'] for r in twins if r['heightmap'] == name)})", fontsize=9)
+        ax.set_xlabel("view angle at the frame centre (deg)", fontsize=7)
+        ax.set_ylabel("fetches per pixel", fontsize=7)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+    for ax in axes.ravel()[len(maps):]:
+        ax.axis("off")
+    handles, labels = axes.ravel()[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=min(4, len(labels)), fontsize=7, frameon=False)
+    fig.suptitle("Distance-map variants: every fetch to the exact hit (solid: mean, dotted: SIMD-tile 8x4)", fontsize=9)
+    fig.tight_layout(rect=(0, 0.08, 1, 0.96))
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    write_bytes(path, buf.getvalue())
+    return True
 
 
 def _csv(rows: list[dict]) -> str:
@@ -178,7 +229,7 @@ def report(rows: list[dict]) -> str:
     build times and memory."""
     lines = ["# Distance-map variants: fetches per pixel (mean / SIMD-tile 8x4)", "",
              "Every fetch to the final hit (volume fetches and exact-cell gathers), the same tracer for every map. "
-             "Changes: mean / SIMD-tile.", ""]
+             f"Changes: mean / SIMD-tile. Plot: [{PLOT}]({PLOT}).", ""]
     variants = [v.name for v in VARIANTS]
     for name in dict.fromkeys(r["heightmap"] for r in rows):
         mine = [r for r in rows if r["heightmap"] == name and r["tracer"] == "numpy twin"]
