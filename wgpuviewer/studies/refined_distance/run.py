@@ -39,12 +39,13 @@ class Variant:
         """The tracer's view of the map: sectors, bands and max_angle (refined kind) or nothing (plain)."""
         if self.kind != "distance_refined":
             return {}
-        return {"sectors": self.options["sectors"], "bands": self.options["bands"], "max_angle": REFINED_MAX_ANGLE}
+        return {k: self.options[k] for k in ("sectors", "bands", "max_angle")}
 
 
 def _refined(sectors: int, bands: int, technique: str = "") -> Variant:
     name = "single cone" if sectors == bands == 1 else f"{sectors} sectors x {bands} bands"
-    return Variant(name, "distance_refined", {"sectors": sectors, "bands": bands}, technique)
+    return Variant(name, "distance_refined", {"sectors": sectors, "bands": bands, "max_angle": REFINED_MAX_ANGLE},
+                   technique)
 
 
 VARIANTS = (
