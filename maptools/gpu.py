@@ -202,7 +202,7 @@ def _check_volume(g: MapGpu, w: int, h: int, slices: int, subcells: int, volumes
 
 
 def _plain_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale: float, subcells: int, label: str):
-    """Encode tops + pass_x + pass_y of distance.wgsl; returns (stored plain volume, sub-cell tops, params)."""
+    """Encode tops + pass_x + pass_y of distance.wgsl; returns (stored plain volume, sub-cell tops)."""
     from . import distance as dist
 
     k = subcells
@@ -214,7 +214,7 @@ def _plain_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale
     g.dispatch(enc, "distance.wgsl", "tops", {0: params, 1: src, 2: tops}, w * k, h * k, 1)
     g.dispatch(enc, "distance.wgsl", "pass_x", {0: params, 1: tops, 2: rows}, w, h * k, slices)
     g.dispatch(enc, "distance.wgsl", "pass_y", {0: params, 1: rows, 2: out}, w, h, slices)
-    return out, tops, params
+    return out, tops
 
 
 @_guard
@@ -228,7 +228,7 @@ def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: f
     _check_volume(g, w, h, slices, subcells)
     src = g.storage(height, "maptools distance src")
     enc = g.encoder("maptools distance")
-    out, _, _ = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance")
+    out, _ = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance")
     g.submit(enc, "distance")
     return g.read(out, w * h * slices).reshape(slices, h, w)
 
@@ -250,21 +250,20 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
     _check_volume(g, w, h, slices, subcells, min(bands, rf.BANDS_PER_PASS))
     src = g.storage(height, "maptools distance_refined src")
     enc = g.encoder("maptools distance_refined plain")
-    plain, sub_tops, _ = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance_refined")
+    plain, sub_tops = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance_refined")
     g.submit(enc, "distance_refined plain")
     directions = rf.bins(sectors, bands, max_angle)
-    nbands = bands
     lists = [rf.entries(directions[s], subcells, w / h, reach) for s in range(sectors)]  # band independent
     levels = max(e.levels for e in lists)
     n = w * h * slices
     out = np.empty((len(directions) + 1, slices, h, w), np.float16)
-    lanes = min(nbands, rf.BANDS_PER_PASS)
+    lanes = min(bands, rf.BANDS_PER_PASS)
     vol = g.storage(lanes * n * 4, "maptools distance_refined band volumes")
     windows = g.storage(levels * w * h * 4, "maptools distance_refined window tops")
-    passes = [(s, b0) for s in range(sectors) for b0 in range(0, nbands, rf.BANDS_PER_PASS)]
+    passes = [(s, b0) for s in range(sectors) for b0 in range(0, bands, rf.BANDS_PER_PASS)]
     for number, (sector, b0) in enumerate(tqdm(passes, desc="distance_refined (gpu)", unit="pass",
                                                disable=None if progress else True, leave=False)):
-        group = [directions[b * sectors + sector] for b in range(b0, min(b0 + rf.BANDS_PER_PASS, nbands))]
+        group = [directions[b * sectors + sector] for b in range(b0, min(b0 + rf.BANDS_PER_PASS, bands))]
         lane = [0.0] * (4 - len(group))
         p = g.uniform([w, h, slices, subcells, len(lists[sector].rho), levels, len(group), 0,
                        *[float(d.tan_lo) for d in group], *lane, *[float(d.cot_hi) for d in group], *lane,
