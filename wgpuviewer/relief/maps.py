@@ -21,7 +21,7 @@ from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
 
 from . import autotable
-from .techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
+from .techniques import CONE_FILTER, CONE_MAX_RATIO, REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 
 
 @dataclass(frozen=True)
@@ -207,10 +207,6 @@ def _cone(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.
     return create_texture(gpu, [np.asarray(ratios, np.float32)], "r32float", label)
 
 
-#: Relaxed cone map options: the widest stored cone (texels of u per unit t; the build costs O(max_ratio^2)
-#: per texel) and the lookup cone.wgsl uses.
-CONE_MAX_RATIO = 32.0
-CONE_FILTER = "nearest"
 
 #: Depth slices of the distance volumes (maptools' default).
 DISTANCE_SLICES = 16

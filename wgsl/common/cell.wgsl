@@ -33,11 +33,21 @@ fn first_root(a: f32, b: f32, c: f32, len: f32) -> f32 {
 // is a quadratic there (as in wgpuviewer/reference.py). Returns t of the hit, or -1. The cell's four
 // depths come from one textureGather (counted as one fetch), addressed by the material sampler.
 fn cell_hit(cell: vec2i, start: vec2f, dir: vec2f, t0: f32, t1: f32) -> f32 {
+    return cell_root(cell_corners(cell), cell, start, dir, t0, t1);
+}
+
+// The cell's corner depths (c00, c10, c01, c11) (x = +u, y = +v): one textureGather, counted as one fetch.
+fn cell_corners(cell: vec2i) -> vec4f {
     fetch_count += 1u;
     let size = vec2f(textureDimensions(depth_tex, 0));
     // Gather order: (umin, vmax), (umax, vmax), (umax, vmin), (umin, vmin).
     let g = textureGather(0, depth_tex, material_sampler, (vec2f(cell) + 1.0) / size);
-    return cell_root(vec4f(g.w, g.z, g.x, g.y), cell, start, dir, t0, t1);
+    return vec4f(g.w, g.z, g.x, g.y);
+}
+
+// The bilinear depth at offset e in [0, 1]^2 inside a cell with corner depths c: cell_root's surface.
+fn cell_depth(c: vec4f, e: vec2f) -> f32 {
+    return c.x + (c.y - c.x) * e.x + (c.z - c.x) * e.y + (c.w - c.y - c.z + c.x) * e.x * e.y;
 }
 
 // cell_hit's solve for given corner depths c = (c00, c10, c01, c11) (x = +u, y = +v): no fetch.
@@ -50,7 +60,7 @@ fn cell_root(c: vec4f, cell: vec2i, start: vec2f, dir: vec2f, t0: f32, t1: f32) 
     let cy = c01 - c00;
     let exy = c11 - c10 - c01 + c00;
     let e = clamp(start + t0 * dir - vec2f(cell), vec2f(0.0), vec2f(1.0));
-    let qc = t0 - (c00 + bx * e.x + cy * e.y + exy * e.x * e.y);
+    let qc = t0 - cell_depth(c, e);
     if qc >= 0.0 {
         return t0;
     }
