@@ -27,6 +27,16 @@ MAX_LAYERS = 1024
 
 #: quadmax's default step cap (auto's quadmax candidate runs with it too).
 QUADMAX_STEPS = 1024
+#: quadmax's default start-level offset (quadmax_pom's skip uses it too).
+QUADMAX_TOP_OFFSET = -2
+#: The relaxed cone map the cone tracer reads (maps.py builds it): its widest stored cone (texels of u per unit t;
+#: the build costs O(max_ratio^2) per texel) and its lookup (cone.wgsl reads the nearest texel).
+CONE_MAX_RATIO = 32.0
+CONE_FILTER = "nearest"
+#: cone.wgsl's bracket finish: halvings that bring any bracket to one cell (a ray crosses < 2^24 cells: a span
+#: clamped at MIN_VIEW_Z on an 8192-texel map), and the cells a one-cell bracket crosses (one x, one y border).
+CONE_HALVINGS_MAX = 24
+CONE_FINISH_CELLS = 3
 
 
 @dataclass(frozen=True)
@@ -128,7 +138,7 @@ REFINED_MAX_ANGLE = 85.0
 #: probe measures each one as that technique (relief/autotable.py).
 AUTO_CANDIDATES: tuple[tuple[str, dict], ...] = (
     ("basic", {}), ("parallax", {}),
-    *(("pom", {"layers": n}) for n in (4, 8, 16, 32, 64)),
+    *(("pom", {"layers": n}) for n in (4, 6, 8, 12, 16, 24, 32, 48, 64)),
     ("quadmax", {}),
 )
 #: auto's method ids in its table (auto.wgsl switches on them).
@@ -255,10 +265,25 @@ TECHNIQUES: dict[str, Technique] = {
             "one atlas texel per quad node read + one per leaf (at most 2 per step)",
             ("albedo", "normal", "depth", "quadmax"),
             (
-                Param("top_offset", -2, -8, 8, int, "start level = floor(log2(ray reach in texels)) + this (>= 1)"),
+                Param("top_offset", QUADMAX_TOP_OFFSET, -8, 8, int, "start level = floor(log2(ray reach in texels)) + this (>= 1)"),
                 Param("max_steps", QUADMAX_STEPS, 1, 65536, int, "cap on traversal steps (capped rays are flagged)"),
             ),
             ray_search=True, fetch_bound=lambda p: 2 * p["max_steps"],
+        ),
+        Technique(
+            "quadmax_pom", "-",
+            "Hybrid (the quadtree-displacement idea): quadmax's exact walk cut after skip_steps steps, then POM with "
+            "`layers` layers over the rest of the ray from the last point the walk proved free. Exact where the walk "
+            "meets the surface in time; otherwise approximate (the layers can step over thin features), error "
+            "measured by the probe and the benchmark.",
+            "at most 2*skip_steps quadmax atlas fetches, then layers + 1 depth fetches",
+            ("albedo", "normal", "depth", "quadmax"),
+            (
+                Param("skip_steps", 8, 1, 64, int, "quadmax steps before the POM finish"),
+                Param("layers", 16, 1, MAX_LAYERS, int, "POM layers over the rest of the ray"),
+            ),
+            ray_search=True, fixed=(("top_offset", float(QUADMAX_TOP_OFFSET)),),
+            fetch_bound=lambda p: 2 * p["skip_steps"] + p["layers"] + 1,
         ),
         Technique(
             "auto", "-",
@@ -278,19 +303,19 @@ TECHNIQUES: dict[str, Technique] = {
         ),
         Technique(
             "cone", "-",
-            "Relaxed cone stepping (Policarpo & Oliveira) on maptools' conservative cone map: steps of "
-            "(D - t) c / (k + c) that never pass the first hit, then binary search of the bracket (the free end "
-            "is returned). Rays usually converge onto the surface and stop within gap_stop of it.",
-            "per cone step 1 depth + 1 cone-map fetch, then binary_steps depth fetches: "
-            "at most 2*iterations + binary_steps",
+            "Robust relaxed cone stepping (Policarpo & Oliveira's relaxed cone map, conservative for the bilinear "
+            "surface; Bán et al. 2024's rule: never step less than to the cell's border): each step solves the "
+            "current cell exactly and skips on by the cone when that leaves the cell; a cone step that ends in the "
+            "relief is halved to one cell and solved exactly. Never passes a surface.",
+            "per step 1 cell gather + 1 cone-map fetch (skipped where no cone could leave the cell); a bracket "
+            f"adds up to {CONE_HALVINGS_MAX} halvings and {CONE_FINISH_CELLS} cells: "
+            f"at most 2*iterations + {CONE_HALVINGS_MAX + CONE_FINISH_CELLS}",
             ("albedo", "normal", "depth", "cone"),
-            (
-                Param("iterations", 128, 1, 4096, int, "cap on cone steps (capped rays are flagged, stop short)"),
-                Param("binary_steps", 6, 0, 32, int, "halvings of the bracket once a step ends below the surface"),
-                Param("gap_stop", 1e-4, 0.0, 0.1, float, "stop when the ray is this close above the surface "
-                      "(layer depth t)"),
-            ),
-            ray_search=True, fetch_bound=lambda p: 2 * p["iterations"] + p["binary_steps"],
+            (Param("iterations", 128, 1, 4096, int, "cap on steps (cell solves + cone skips); capped rays flagged"),),
+            ray_search=True, exact=True,
+            fixed=(("max_ratio", CONE_MAX_RATIO), ("halvings_max", float(CONE_HALVINGS_MAX)),
+                   ("finish_cells", float(CONE_FINISH_CELLS))),
+            fetch_bound=lambda p: 2 * p["iterations"] + CONE_HALVINGS_MAX + CONE_FINISH_CELLS,
         ),
     )
 }

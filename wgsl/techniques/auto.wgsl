@@ -42,7 +42,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
             r = parallax_offset(uv0, v, lod, false);
         }
         case AUTO_POM: {
-            r = pom_search(uv0, v, lod, u32(clamp(choice.z, 1.0, f32(MAX_LAYERS))));
+            r = pom_search(uv0, v, lod, 0.0, u32(clamp(choice.z, 1.0, f32(MAX_LAYERS))));
         }
         default: {
             r = quadmax_search(uv0, v, choice.z, u32(trace_params.quadmax_steps));

@@ -25,5 +25,5 @@ fn adaptive_layer_count(uv0: vec2f, v: vec3f) -> u32 {
 
 fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     fetch_count = 0u;
-    return pom_search(uv0, v, lod, adaptive_layer_count(uv0, v));
+    return pom_search(uv0, v, lod, 0.0, adaptive_layer_count(uv0, v));
 }
