@@ -265,7 +265,8 @@ TECHNIQUES: dict[str, Technique] = {
             "one atlas texel per quad node read + one per leaf (at most 2 per step)",
             ("albedo", "normal", "depth", "quadmax"),
             (
-                Param("top_offset", QUADMAX_TOP_OFFSET, -8, 8, int, "start level = floor(log2(ray reach in texels)) + this (>= 1)"),
+                Param("top_offset", QUADMAX_TOP_OFFSET, -8, 8, int,
+                      "start level = floor(log2(ray reach in texels)) + this (>= 1)"),
                 Param("max_steps", QUADMAX_STEPS, 1, 65536, int, "cap on traversal steps (capped rays are flagged)"),
             ),
             ray_search=True, fetch_bound=lambda p: 2 * p["max_steps"],
