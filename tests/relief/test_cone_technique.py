@@ -10,9 +10,10 @@ import pytest
 from maptools.cache import cached_generate
 from maptools.trace import cone_trace
 from wgpuviewer.cli import main
+from wgpuviewer.core.sampling import bilinear
 from wgpuviewer.core.wgsl import read_wgsl
 from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
-from wgpuviewer.relief.maps import MAP_SLOTS
+from wgpuviewer.relief.maps import MAP_SLOTS, footprint_min_depth
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
 from wgpuviewer.relief.techniques import (
@@ -146,6 +147,23 @@ def test_head_on_view_is_exact_in_one_fetch(gpu):
     got = probe("cone", h, uv, v, 0.05)
     ref = exact_hit(1.0 - h, uv, v, 0.05)
     assert np.allclose(got.depth, ref.t, atol=1e-5) and (got.fetches == 1).all() and not got.capped.any()
+
+
+@pytest.mark.parametrize("fmt", ("r32float", "r16float"))
+def test_footprint_min_depth_bounds_the_bilinear_surface(fmt):
+    """The packed texel's depth is a lower bound of the sampled surface anywhere in the texel's footprint, in the
+    depth texture's own precision (r16float on adapters without float32 filtering), NPOT and wrapping included."""
+    depth = 1.0 - npot_height()[:40, :56]
+    stored = depth.astype(np.float16 if fmt == "r16float" else np.float32).astype(np.float64)
+    low = footprint_min_depth(depth, fmt)
+    h, w = depth.shape
+    rng = np.random.default_rng(4)
+    texel = np.stack([rng.integers(0, w, 20000), rng.integers(0, h, 20000)], -1)
+    uv = (texel + rng.random((20000, 2))) / np.array([w, h])  # a point of each texel's footprint
+    surface = bilinear(stored, uv)
+    assert (low[texel[:, 1], texel[:, 0]] <= surface + 1e-7).all()
+    # and a local bound, not the map's minimum (which would prove nothing free above the relief's lowest point)
+    assert (low > stored.min() + 0.05).mean() > 0.5
 
 
 def test_cone_map_is_maptools_map(gpu):

@@ -196,7 +196,7 @@ class Row:
 
 
 #: Bytes per texel of the formats the height-derived maps use (map memory per technique).
-FORMAT_BYTES = {"r8unorm": 1, "r16float": 2, "r32float": 4, "rgba8unorm": 4, "rgba16float": 8, "rgba32float": 16,
+FORMAT_BYTES = {"r8unorm": 1, "r16float": 2, "r32float": 4, "rg32float": 8, "rgba8unorm": 4, "rgba16float": 8, "rgba32float": 16,
                 "rgba32uint": 16}
 
 

@@ -130,6 +130,7 @@ def describe_adapters(backend: str | None = None) -> str:
 _TEXEL = {  # format -> (numpy dtype, channels)
     "r32float": (np.float32, 1),
     "r16float": (np.float16, 1),
+    "rg32float": (np.float32, 2),
     "rgba16float": (np.float16, 4),
     "rgba32float": (np.float32, 4),
     "rgba8unorm": (np.uint8, 4),

@@ -200,12 +200,22 @@ def _distance_refined(gpu: Gpu, depth: np.ndarray, height_scale: float, label: s
     return _volume_texture(gpu, volumes, label)
 
 
-def _cone(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
-    # The ratios do not depend on height_scale (texels of u per unit t); cone.wgsl reads them with
-    # textureLoad (nearest texel), the lookup a filter="nearest" map is built for.
-    ratios = cached_generate("cone", 1.0 - depth, backend="auto", max_ratio=CONE_MAX_RATIO, filter=CONE_FILTER)
-    return create_texture(gpu, [np.asarray(ratios, np.float32)], "r32float", label)
+def footprint_min_depth(depth: np.ndarray, fmt: str) -> np.ndarray:
+    """Per texel q, a lower bound of the bilinear depth anywhere in q's footprint [i, i+1] x [j, j+1] (u * W, v * H):
+    the minimum of the 3x3 texels around q (wrap), the texels that footprint's bilinear surface mixes, in the depth
+    texture's precision (``fmt``: r32float or r16float, as uploaded), float32 (H, W)."""
+    d = np.asarray(depth, np.float16 if fmt == "r16float" else np.float32).astype(np.float32)
+    out = np.minimum(d, np.minimum(np.roll(d, 1, axis=1), np.roll(d, -1, axis=1)))
+    return np.minimum(out, np.minimum(np.roll(out, 1, axis=0), np.roll(out, -1, axis=0)))
 
+
+def _cone(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    # The ratios do not depend on height_scale (texels of u per unit t); cone.wgsl reads (ratio, footprint min
+    # depth) with textureLoad (nearest texel), the lookup a filter="nearest" map is built for: one fetch per cone
+    # step, which proves the ray free where it is above the footprint's lowest depth.
+    ratios = cached_generate("cone", 1.0 - depth, backend="auto", max_ratio=CONE_MAX_RATIO, filter=CONE_FILTER)
+    packed = np.stack([np.asarray(ratios, np.float32), footprint_min_depth(depth, gpu.depth_format)], axis=-1)
+    return create_texture(gpu, [packed], "rg32float", label)
 
 
 #: Depth slices of the distance volumes (maptools' default).
@@ -233,7 +243,7 @@ MAP_SLOTS: dict[str, MapSlot] = {
                 "direction-binned refined volumes and the plain one, stacked along the depth (r16float), textureLoad",
                 scale_bound=True, variable="distance_tex"),
         MapSlot("cone", _2D, _UNFILTERABLE_2D, _cone,
-                "relaxed cone ratios (r32float), texels of u per unit t, textureLoad"),
+                "relaxed cone ratio (texels of u per unit t) and footprint min depth (rg32float), textureLoad"),
         MapSlot("quadmax", "texture_2d<u32>", _UINT_2D, _quadmax,
                 "max quadtree atlas (rgba32uint): packed 14-bit leaves (level 1), children's maxima (levels >= 2)"),
         MapSlot("auto_table", _2D, _UNFILTERABLE_2D, _auto_table,

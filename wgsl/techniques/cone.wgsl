@@ -3,37 +3,38 @@
 // (the idea of Bán et al. 2024, "Robust Cone Step Mapping": never step less than to the cell's border),
 // and an exact finish when a cone step ends inside the relief.
 //
-// The map and its contract are maptools' (docs/maps.md, "Relaxed cone map"): cone_tex (r32float, W x H,
-// read with textureLoad = the nearest texel q, the lookup a filter = nearest map is built for) stores c in
-// texels of u per unit of layer depth t, such that from any point p of q's footprint and any t < D(p), a ray
-// segment inside the upward cone {(x, s): |x - p| <= c (D(p) - s)} has no solid -> free transition: it
-// enters the relief at most once and never leaves it. A ray moves k = |V.xy / V.z| * S * W texels of u per
-// unit t. Cell coordinates x = u * W - 0.5 (cells between texel centres, as cell.wgsl).
+// The map and its contract are maptools' (docs/maps.md, "Relaxed cone map"): from any point p of texel q's
+// footprint and any t < D(p), a ray segment inside the upward cone {(x, s): |x - p| <= c (D(p) - s)} has no
+// solid -> free transition: it enters the relief at most once and never leaves it. cone_tex (rg32float, W x H,
+// read with textureLoad = the nearest texel q, the lookup a filter = nearest map is built for) packs c (texels
+// of u per unit of layer depth t) with d_q, the lowest depth in q's footprint (maps.footprint_min_depth: the
+// minimum of the 3x3 texels the footprint's bilinear surface mixes). A cone whose apex is shallower than D(p)
+// lies inside the true one, so any lower bound of D(p) may serve as the apex. A ray moves k = |V.xy / V.z| * S * W
+// texels of u per unit t. Cell coordinates x = u * W - 0.5 (cells between texel centres, as cell.wgsl).
 //
-// Per step, at a point (p, t) that is free or was reached by a cone step:
-// 1. gather the corners of p's cell (1 fetch) and solve the cell exactly from t to where the ray leaves it.
-//    A root after t is the first hit (everything before t is free, see 3), returned exactly. A root AT t
-//    after a cone step means that step ended inside the relief: go to 4.
-// 2. the ray is free up to the cell's exit t_exit (t_free = t_exit).
-// 3. relaxed cone step: the apex depth D(p) is at least the cell's lowest corner d_lo, and the cone of a
-//    shallower apex lies inside the cone of the true one, so t_cone = t + (d_lo - t) c / (k + c) (cone fetch:
-//    1 fetch, skipped when even the widest stored cone could not pass t_exit) keeps the guarantee. Go to
-//    t_cone if it lies past t_exit, else to t_exit (next cell). No Zeno crawl: every step leaves the cell.
-//    A cone step that ends free was free throughout (free -> solid -> free is excluded), so the next
-//    step's start is again preceded by free ray only.
-// 4. a cone step [t_free, t] ended solid: the relief there is ONE interval [t*, t]. Halve the bracket
-//    with exact bilinear depths (1 gather each) until it spans at most one cell, then solve the (at most
-//    3) cells it crosses exactly: the first root is t*.
+// A step from t (everything before t_free is proven free; t itself was reached by a cone step or a cell exit):
+// 1. skip (after a cone step): read q's texel (1 fetch). If t < d_q the ray is free here; if the cone step
+//    t_cone = t + (d_q - t) c / (k + c) also leaves the current cell, take it: 1 fetch per skip.
+// 2. otherwise solve the cell exactly (1 gather) from t to its exit. A root after t is the first hit (a free
+//    point reached by a cone step from a free one makes the whole step free). A root AT t after a cone step
+//    means that step ended inside the relief: go to 4. No root: free up to the exit (t_free).
+// 3. from the cell, cone step with the apex at max(d_q, the cell's lowest corner); the texel is read here only
+//    when even the widest stored cone could leave the cell (so rays crawling along the surface pay 1 gather per
+//    cell). Go to t_cone if it lies past the cell's exit, else to the exit (the next cell): every step leaves
+//    the cell, no Zeno crawl.
+// 4. a cone step [t_free, t] that ended solid holds ONE solid interval [t*, t]: halve it with exact bilinear
+//    depths (1 gather each) until it spans at most one cell, then solve the (at most 3) cells it crosses
+//    exactly: the first root is t*.
 // Bounded: `iterations` steps of at most 2 fetches, then halvings_max halvings and finish_cells cells
 // (fixed values from the registry: enough halvings for any bracket, and a one-cell bracket crosses <= 3 cells).
 // A capped ray returns its last free point t_free, flagged (short of the hit, never behind it).
 // Grazing, horizontal and back-facing views are clamped by parallax_span and flagged (is_grazing).
 // #include "common/cell.wgsl"
 
-fn cone_ratio_at(p: vec2f, wh: vec2i) -> f32 {
+// (ratio c, footprint min depth d_q) of the texel q under the cell-coordinate point p: floor(u * W) = floor(x + 0.5).
+fn cone_texel_at(p: vec2f, wh: vec2i) -> vec2f {
     fetch_count += 1u;
-    // Texel q of the cell-coordinate point p: floor(u * W) = floor(x + 0.5).
-    return textureLoad(cone_tex, wrap_texel(vec2i(floor(p + 0.5)), wh), 0).r;
+    return textureLoad(cone_tex, wrap_texel(vec2i(floor(p + 0.5)), wh), 0).rg;
 }
 
 fn cone_hit(uv0: vec2f, span: vec2f, t: f32, v: vec3f) -> TraceResult {
@@ -50,13 +51,29 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     let widest = trace_params.max_ratio;    // the map's largest stored ratio
     let cap = u32(clamp(trace_params.iterations, 1.0, ITERATIONS_MAX));
     var t = 0.0;
-    var t_free = 0.0;  // the ray is free on [0, t_free]
+    var t_free = 0.0;   // the ray is free on [0, t_free]
     var cell = vec2i(floor(start));
+    // The last step went to a cell's exit (or, at the start, no cone could leave the first cell even from the top
+    // of the relief): the cell is solved first.
+    var crawl = widest <= walk_node(cell, 0u, wh, start, dir).t_exit * (k + widest);
     var bracketed = false;
     for (var i = 0u; i < cap; i++) {
         let n = walk_node(cell, 0u, wh, start, dir);
-        let c = cell_corners(cell);
-        let hit = cell_root(c, cell, start, dir, t, n.t_exit);
+        var texel = vec2f(-1.0);  // (c, d_q) once read
+        if !crawl {
+            texel = cone_texel_at(start + t * dir, wh);
+            if t < texel.y {
+                let t_cone = t + (texel.y - t) * texel.x / (k + texel.x);
+                if t_cone > n.t_exit {
+                    t_free = t;
+                    t = t_cone;
+                    cell = vec2i(floor(start + t * dir));
+                    continue;
+                }
+            }
+        }
+        let corners = cell_corners(cell);
+        let hit = cell_root(corners, cell, start, dir, t, n.t_exit);
         if hit >= 0.0 {
             if hit > t || t <= t_free {
                 return cone_hit(uv0, span, hit, v);
@@ -65,18 +82,22 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
             break;
         }
         t_free = n.t_exit;
-        let gap = min(min(c.x, c.y), min(c.z, c.w)) - t;
-        var t_next = n.t_exit;
-        if gap * widest > (n.t_exit - t) * (k + widest) {
-            let ratio = cone_ratio_at(start + t * dir, wh);
-            t_next = max(t_next, t + gap * ratio / (k + ratio));
+        var apex = max(min(min(corners.x, corners.y), min(corners.z, corners.w)), texel.y);
+        if texel.x < 0.0 && (apex - t) * widest > (n.t_exit - t) * (k + widest) {
+            texel = cone_texel_at(start + t * dir, wh);
+            apex = max(apex, texel.y);
         }
-        if t_next > n.t_exit {
-            t = t_next;
-            cell = vec2i(floor(start + t * dir));
-        } else {
+        var t_next = n.t_exit;
+        if texel.x >= 0.0 && apex > t {
+            t_next = max(t_next, t + (apex - t) * texel.x / (k + texel.x));
+        }
+        crawl = t_next <= n.t_exit;
+        if crawl {
             t = n.t_exit;
             cell = next_cell(start, dir, t, n.exits, n.lo, n.hi);
+        } else {
+            t = t_next;
+            cell = vec2i(floor(start + t * dir));
         }
     }
     if !bracketed {
