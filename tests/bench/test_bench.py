@@ -118,6 +118,21 @@ def test_headline_picks_the_cheapest_configuration_within_each_budget():
     assert bench_report.headline([_row("basic", "-", 0, 1.0, 5.0)])[0]["config"] is None
 
 
+def test_headline_lists_configurations_close_to_the_winner():
+    """Within CLOSE_MARGIN of the winner's time (a tie on a noisy adapter) a configuration is listed beside it;
+    one just outside is not, nor one that misses the budget."""
+    rows = [_row("distance_refined", "iterations=256", 45, 1.65, 0.0), _row("auto", "max_error=0.5", 45, 1.69, 0.4),
+            _row("quadmax", "-", 45, 1.65 * (1 + bench_report.CLOSE_MARGIN) + 0.01, 0.0),
+            _row("pom", "layers=8", 45, 1.60, 0.9)]
+    best = {h["budget"]: h for h in bench_report.headline(rows)}
+    assert best[0.5]["config"] == ("distance_refined", "iterations=256")
+    assert [m["config"] for m in best[0.5]["close"]] == [("auto", "max_error=0.5")]
+    assert best[0.25]["close"] == []  # auto's 0.4 misses 0.25
+    # at 1 texel POM (1.60) wins; 1.68 is the margin: distance_refined (1.65) is close, auto (1.69) is not
+    assert best[1.0]["config"] == ("pom", "layers=8")
+    assert [m["config"][0] for m in best[1.0]["close"]] == ["distance_refined"]
+
+
 def test_equal_error_speedup_uses_the_cheapest_pom_at_least_as_accurate():
     rows = [_row("pom_adaptive", "-", 45, 1.2, 0.3, ms=1.2),
             _row("pom", "layers=8", 45, 1.0, 0.9, ms=1.0),

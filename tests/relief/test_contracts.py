@@ -1,7 +1,8 @@
 """What every ray-search technique of the registry promises, tested for each one automatically (a new technique
 gets these tests by being registered): finite results at grazing views, flagged results for views with V.z = 0
 and back-facing ones, fetch counts within the technique's declared bound, and for exact tracers never a hit
-behind the float64 first hit. Technique test files keep only their own claims."""
+behind the float64 first hit, and the hit itself on axis-aligned rays along texel-centre lines and cell borders (where
+a position rounds into the neighbouring cell). Technique test files keep only their own claims."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import pytest
 
 from wgpuviewer.relief.accuracy import random_rays
 from wgpuviewer.relief.probe import probe
-from wgpuviewer.relief.reference import exact_hit
+from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
 from wgpuviewer.relief.techniques import TECHNIQUES
 from wgpuviewer.textures import builtin_height
 
@@ -78,3 +79,32 @@ def test_exact_tracers_never_pass_the_first_hit(gpu, technique, name):
         ref = exact_hit(1.0 - h, uv, view, 0.05)
         ok = ref.valid
         assert (got.depth[ok] <= ref.t[ok] + T_TOL).all(), (angle, float(np.max(got.depth[ok] - ref.t[ok])))
+
+
+def axis_aligned_rays(n: int, angle: float, azimuth: float) -> tuple[np.ndarray, np.ndarray]:
+    """Entry points on texel centres (a line of constant u) and on cell borders (texel corners, cell coordinates
+    x = u * W - 0.5 integral), rays along +-u or +-v: one direction component is 0 up to float64 rounding."""
+    centres = (np.arange(n) + 0.5) / n
+    corners = (np.arange(n) + 1.0) / n
+    uv = np.concatenate([np.stack([centres, np.full(n, 0.37)], -1), np.stack([corners, corners[::-1]], -1),
+                         np.stack([np.full(n, 0.37), centres], -1)])
+    return uv, view_dir_from_angles(np.full(len(uv), angle), np.full(len(uv), azimuth))
+
+
+#: UV error (texels) of an exact tracer's uncapped rays: float32 rounding only.
+EXACT_TEXELS = 0.01
+
+
+@pytest.mark.parametrize("technique", EXACT)
+@pytest.mark.parametrize("name", ("wall", "step", "spike", "checker"))
+def test_exact_tracers_on_axis_aligned_rays(gpu, technique, name):
+    h = height_map(name)
+    for angle in (45.0, 80.0, 85.0):
+        for azimuth in (0.0, 90.0, 180.0, 270.0):
+            uv, view = axis_aligned_rays(64, angle, azimuth)
+            got = probe(technique, h, uv, view, 0.05)
+            ref = exact_hit(1.0 - h, uv, view, 0.05)
+            ok = ref.valid & ~got.capped
+            assert ok.mean() >= 0.99, (angle, azimuth, ok.mean())
+            err = uv_error_texels(got.uv[ok], ref.uv[ok], h.shape)
+            assert err.max() <= EXACT_TEXELS, (angle, azimuth, float(err.max()))

@@ -55,6 +55,10 @@ def _layers(params: str) -> int | None:
 
 # --- headline ---------------------------------------------------------------------------------
 
+#: Configurations within this fraction of the headline winner's time are listed beside it.
+CLOSE_MARGIN = 0.05
+
+
 def headline(values: list[dict], max_angle: float = HEADLINE_MAX_ANGLE) -> list[dict]:
     """Per budget: the configuration with the lowest geometric-mean time ratio to basic among those
     whose p95 UV error is within the budget in every measurement (height map x angle <= max_angle)."""
@@ -75,10 +79,6 @@ def headline(values: list[dict], max_angle: float = HEADLINE_MAX_ANGLE) -> list[
         best["close"] = [m for m in meeting[1:] if m["ratio"] <= best["ratio"] * (1 + CLOSE_MARGIN)]
         out.append(best)
     return out
-
-
-#: Configurations within this fraction of the headline winner's time are listed beside it.
-CLOSE_MARGIN = 0.05
 
 
 def cost_of(vs: list[dict]) -> dict:

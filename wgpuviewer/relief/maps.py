@@ -204,7 +204,9 @@ def footprint_min_depth(depth: np.ndarray, fmt: str) -> np.ndarray:
     """Per texel q, a lower bound of the bilinear depth anywhere in q's footprint [i, i+1] x [j, j+1] (u * W, v * H):
     the minimum of the 3x3 texels around q (wrap), the texels that footprint's bilinear surface mixes, in the depth
     texture's precision (``fmt``: r32float or r16float, as uploaded), float32 (H, W)."""
-    d = np.asarray(depth, np.float16 if fmt == "r16float" else np.float32).astype(np.float32)
+    d = np.asarray(depth, np.float32)  # the upload's path: float32 first, then the texture's format
+    if fmt == "r16float":
+        d = d.astype(np.float16).astype(np.float32)
     out = np.minimum(d, np.minimum(np.roll(d, 1, axis=1), np.roll(d, -1, axis=1)))
     return np.minimum(out, np.minimum(np.roll(out, 1, axis=0), np.roll(out, -1, axis=0)))
 

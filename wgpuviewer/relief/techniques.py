@@ -33,10 +33,11 @@ QUADMAX_TOP_OFFSET = -2
 #: the build costs O(max_ratio^2) per texel) and its lookup (cone.wgsl reads the nearest texel).
 CONE_MAX_RATIO = 32.0
 CONE_FILTER = "nearest"
-#: cone.wgsl's bracket finish: halvings that bring any bracket to one cell (a ray crosses < 2^24 cells: a span
-#: clamped at MIN_VIEW_Z on an 8192-texel map), and the cells a one-cell bracket crosses (one x, one y border).
+#: cone.wgsl's bracket finish: halvings that bring a bracket to one cell (24: float32 t cannot be split further
+#: anyway; a longer bracket ends flagged at its free end), and the cells a one-cell bracket crosses (one x and one
+#: y border) plus the cell its start may round into.
 CONE_HALVINGS_MAX = 24
-CONE_FINISH_CELLS = 3
+CONE_FINISH_CELLS = 4
 
 
 @dataclass(frozen=True)

@@ -68,7 +68,7 @@ fn leaf_hit(w: vec4u, lo: vec2i, hi: vec2i, cell0: vec2i, start: vec2f, dir: vec
         if t1 >= t_exit {
             break;
         }
-        t = t1;
+        t = max(t, t1);  // a cell the ray only grazes by rounding exits before t: never step back
         cell += vec2i(select(0, select(-1, 1, dir.x > 0.0), exits.x <= t1),
                       select(0, select(-1, 1, dir.y > 0.0), exits.y <= t1));
         if any(cell < lo) || any(cell >= hi) {
@@ -87,7 +87,18 @@ fn quad_row(rows: i32, m: u32) -> i32 {
     return i32(n - countOneBits(n) - q + countOneBits(q) + m - 1u);
 }
 
+// The walk's outcome: its result, and whether it met the surface (false: the step cap ended it at result.depth,
+// a point proven free; quadmax_pom continues from there).
+struct QuadmaxWalk {
+    result: TraceResult,
+    found: bool,
+}
+
 fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> TraceResult {
+    return quadmax_walk(uv0, v, top_offset, max_steps).result;
+}
+
+fn quadmax_walk(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> QuadmaxWalk {
     let wh = vec2i(textureDimensions(depth_tex, 0));
     // The root: the first level (>= 1) of one node (sizes ceil-halve: level m has ceil(W / 2^m) columns).
     let root = max(1u, 32u - countLeadingZeros(u32(max(wh.x, wh.y) - 1)));
@@ -147,7 +158,7 @@ fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> Trac
             let leaf = textureLoad(quadmax_tex, node, 0);
             let t_hit = leaf_hit(leaf, lo, hi, cell, start, dir, t, t_exit);
             if t_hit >= 0.0 {
-                return TraceResult(uv0 - span * t_hit, t_hit, fetch_count, is_grazing(v), 0u);
+                return QuadmaxWalk(TraceResult(uv0 - span * t_hit, t_hit, fetch_count, is_grazing(v), 0u), true);
             }
         }
         // Nothing in this node: step into the next one along the ray. Look from one level up only when that one
@@ -157,5 +168,5 @@ fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> Trac
         let same_parent = all((wrap_texel(cell, wh) >> vec2u(up)) == (node >> vec2u(1u)));
         level = select(min(up, top), level, same_parent && level < top);
     }
-    return TraceResult(uv0 - span * t, t, fetch_count, true, 0u);
+    return QuadmaxWalk(TraceResult(uv0 - span * t, t, fetch_count, true, 0u), false);
 }

@@ -18,15 +18,16 @@
 // 2. otherwise solve the cell exactly (1 gather) from t to its exit. A root after t is the first hit (a free
 //    point reached by a cone step from a free one makes the whole step free). A root AT t after a cone step
 //    means that step ended inside the relief: go to 4. No root: free up to the exit (t_free).
-// 3. from the cell, cone step with the apex at max(d_q, the cell's lowest corner); the texel is read here only
-//    when even the widest stored cone could leave the cell (so rays crawling along the surface pay 1 gather per
-//    cell). Go to t_cone if it lies past the cell's exit, else to the exit (the next cell): every step leaves
-//    the cell, no Zeno crawl.
+// 3. from the cell, cone step with the apex at the cell's lowest corner (<= D(p); q is one of the corners, so it
+//    is never below d_q); the texel is read here only when even the widest stored cone could leave the cell (so
+//    rays crawling along the surface pay 1 gather per cell). Go to t_cone if it lies past the cell's exit, else
+//    to the exit (the next cell): every step leaves the cell, no Zeno crawl inside a cell.
 // 4. a cone step [t_free, t] that ended solid holds ONE solid interval [t*, t]: halve it with exact bilinear
-//    depths (1 gather each) until it spans at most one cell, then solve the (at most 3) cells it crosses
-//    exactly: the first root is t*.
-// Bounded: `iterations` steps of at most 2 fetches, then halvings_max halvings and finish_cells cells
-// (fixed values from the registry: enough halvings for any bracket, and a one-cell bracket crosses <= 3 cells).
+//    depths (1 gather each) until it spans at most one cell, then solve the cells it crosses exactly (at most 3,
+//    plus the one its start may round into): the first root is t*.
+// Bounded: `iterations` steps of at most 2 fetches, then halvings_max halvings and finish_cells cells (fixed values
+// from the registry). A ray whose bracket the halvings cannot bring to one cell (float32 t runs out first) or whose
+// finish finds no root to rounding ends at the bracket's free end, flagged.
 // A capped ray returns its last free point t_free, flagged (short of the hit, never behind it).
 // Grazing, horizontal and back-facing views are clamped by parallax_span and flagged (is_grazing).
 // #include "common/cell.wgsl"
@@ -37,8 +38,9 @@ fn cone_texel_at(p: vec2f, wh: vec2i) -> vec2f {
     return textureLoad(cone_tex, wrap_texel(vec2i(floor(p + 0.5)), wh), 0).rg;
 }
 
-fn cone_hit(uv0: vec2f, span: vec2f, t: f32, v: vec3f) -> TraceResult {
-    return TraceResult(uv0 - span * t, t, fetch_count, is_grazing(v), 0u);
+// `layers` (the layers debug view): 1 where the bracket finish ran, else 0.
+fn cone_result(uv0: vec2f, span: vec2f, t: f32, capped: bool, bracketed: bool) -> TraceResult {
+    return TraceResult(uv0 - span * t, t, fetch_count, capped, select(0u, 1u, bracketed));
 }
 
 fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
@@ -59,12 +61,17 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     var bracketed = false;
     for (var i = 0u; i < cap; i++) {
         let n = walk_node(cell, 0u, wh, start, dir);
+        if n.t_exit <= t && t < 1.0 {
+            // A cone step's end rounded into a cell the ray has already left: move on (no fetch, no stall).
+            cell = next_cell(start, dir, t, n.exits, n.lo, n.hi);
+            continue;
+        }
         var texel = vec2f(-1.0);  // (c, d_q) once read
         if !crawl {
             texel = cone_texel_at(start + t * dir, wh);
             if t < texel.y {
                 let t_cone = t + (texel.y - t) * texel.x / (k + texel.x);
-                if t_cone > n.t_exit {
+                if t_cone > n.t_exit && t_cone > t {
                     t_free = t;
                     t = t_cone;
                     cell = vec2i(floor(start + t * dir));
@@ -76,16 +83,16 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
         let hit = cell_root(corners, cell, start, dir, t, n.t_exit);
         if hit >= 0.0 {
             if hit > t || t <= t_free {
-                return cone_hit(uv0, span, hit, v);
+                return cone_result(uv0, span, hit, is_grazing(v), false);
             }
             bracketed = true;  // the cone step [t_free, t] ended inside the relief
             break;
         }
         t_free = n.t_exit;
-        var apex = max(min(min(corners.x, corners.y), min(corners.z, corners.w)), texel.y);
+        // The cell's lowest corner bounds D(p) from below (and is at least d_q: q is one of the corners).
+        let apex = min(min(corners.x, corners.y), min(corners.z, corners.w));
         if texel.x < 0.0 && (apex - t) * widest > (n.t_exit - t) * (k + widest) {
             texel = cone_texel_at(start + t * dir, wh);
-            apex = max(apex, texel.y);
         }
         var t_next = n.t_exit;
         if texel.x >= 0.0 && apex > t {
@@ -101,7 +108,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
         }
     }
     if !bracketed {
-        return TraceResult(uv0 - span * t_free, t_free, fetch_count, true, 0u);
+        return cone_result(uv0, span, t_free, true, false);
     }
     // [lo, hi]: free at lo, solid at hi, one solid interval inside.
     var lo = t_free;
@@ -121,16 +128,18 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     cell = vec2i(floor(start + lo * dir));
     for (var s = 0u; s < u32(trace_params.finish_cells); s++) {
         let n = walk_node(cell, 0u, wh, start, dir);
-        let hit = cell_root(cell_corners(cell), cell, start, dir, t, min(n.t_exit, hi));
-        if hit >= 0.0 {
-            return cone_hit(uv0, span, hit, v);
+        if n.t_exit > t || t >= 1.0 {  // else lo rounded into a cell the ray has already left: no solve there
+            let hit = cell_root(cell_corners(cell), cell, start, dir, t, min(n.t_exit, hi));
+            if hit >= 0.0 {
+                return cone_result(uv0, span, hit, is_grazing(v), true);
+            }
+            if n.t_exit >= hi {
+                break;
+            }
+            t = n.t_exit;
         }
-        if n.t_exit >= hi {
-            break;
-        }
-        t = n.t_exit;
         cell = next_cell(start, dir, t, n.exits, n.lo, n.hi);
     }
     // Rounding (or the halving cap) left no root found in [lo, hi]: stop at the free end, flagged.
-    return TraceResult(uv0 - span * lo, lo, fetch_count, true, 0u);
+    return cone_result(uv0, span, lo, true, true);
 }
