@@ -463,7 +463,9 @@ def plots(out: Path, values: list[dict]) -> tuple[list[str], str | None]:
     written = []
     maps = list(dict.fromkeys(v["heightmap"] for v in values))
     techniques = list(dict.fromkeys(v["technique"] for v in values))
-    colors = {t: plt.cm.tab10(i % 10) for i, t in enumerate(techniques)}
+    # one colour per technique (tab20 once there are more than ten), one line style per configuration of it
+    palette = plt.cm.tab10 if len(techniques) <= 10 else plt.cm.tab20
+    colors = {t: palette(i % palette.N) for i, t in enumerate(techniques)}
     floor = 1e-3  # p95 of 0 drawn at this value on the log axis
 
     cols = min(3, len(maps)) or 1
@@ -493,24 +495,27 @@ def plots(out: Path, values: list[dict]) -> tuple[list[str], str | None]:
     for ax in axes.ravel()[len(maps):]:
         ax.axis("off")
     handles = [plt.Line2D([], [], marker="o", ls="", color=colors[t], label=t) for t in techniques]
-    fig.legend(handles=handles, loc="lower center", ncol=min(len(techniques), 6), fontsize=7)
-    fig.tight_layout(rect=(0, 0.06, 1, 1))
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(techniques), 7), fontsize=7)
+    fig.tight_layout(rect=(0, 0.04 + 0.035 * math.ceil(len(techniques) / 7), 1, 1))
     _save(fig, out / "pareto.png")
     plt.close(fig)
     written.append("pareto.png")
 
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = plt.subplots(figsize=(10, 4.8))
     by_config = defaultdict(lambda: defaultdict(list))
     for v in values:
         by_config[_key(v)][v["angle"]].append(v["fetches_mean"])
+    styles = ("-", "--", ":", "-.")
+    seen = defaultdict(int)
     for k, per_angle in by_config.items():
         angles = sorted(per_angle)
         ax.plot(angles, [np.mean(per_angle[a]) for a in angles], marker=".", color=colors[k[0]],
-                lw=0.9, label=_label(k))
+                ls=styles[seen[k[0]] % len(styles)], lw=0.9, label=_label(k))
+        seen[k[0]] += 1
     ax.set_yscale("symlog", linthresh=1)
     ax.set_xlabel("view angle at the frame centre (degrees)")
     ax.set_ylabel("depth fetches per pixel (mean over height maps)")
-    ax.legend(fontsize=6, ncol=2)
+    ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
     _save(fig, out / "fetches_vs_angle.png")
     plt.close(fig)
@@ -519,7 +524,7 @@ def plots(out: Path, values: list[dict]) -> tuple[list[str], str | None]:
     c = cost_correlation(values)
     if c["rows"] >= 3:
         rows = [v for v in values if math.isfinite(v.get("fetches_simd", float("nan")))]
-        fig, axes = plt.subplots(1, 2, figsize=(9, 4), sharey=True)
+        fig, axes = plt.subplots(1, 2, figsize=(10.5, 4), sharey=True)
         for ax, column, title, r in ((axes[0], "fetches_mean", "mean fetches per pixel", c["mean"]),
                                       (axes[1], "fetches_simd", "SIMD-tile fetches", c["simd"])):
             for t in techniques:
@@ -530,7 +535,7 @@ def plots(out: Path, values: list[dict]) -> tuple[list[str], str | None]:
             ax.set_xlabel(title)
             ax.set_title(f"Pearson r = {r:.3f} (all rows)", fontsize=9)
         axes[0].set_ylabel("time / basic")
-        axes[1].legend(fontsize=6, ncol=2)
+        axes[1].legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5))
         fig.tight_layout()
         _save(fig, out / "cost_vs_time.png")
         plt.close(fig)
@@ -542,7 +547,7 @@ def _save(fig, path: Path) -> None:
     from wgpuviewer.core.io import write_bytes
 
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=72)
+    fig.savefig(buf, format="png", dpi=72, bbox_inches="tight")  # outside legends included
     write_bytes(path, buf.getvalue())
 
 
