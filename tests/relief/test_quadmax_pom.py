@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from wgpuviewer.core.sampling import bilinear
-from wgpuviewer.relief.accuracy import measure, random_rays
+from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.techniques import AUTO_CANDIDATES, TECHNIQUES
 from wgpuviewer.textures import builtin_height
@@ -24,10 +24,12 @@ def test_registry_entry():
     assert "quadmax_pom" not in {name for name, _ in AUTO_CANDIDATES}
 
 
-@pytest.mark.parametrize("name", ("bricks", "wall", "spike"))
+@pytest.mark.parametrize("name", ("bricks", "wall", "spike", "npot", "1x1"))
 def test_enough_skip_steps_is_quadmax(gpu, name):
-    """A walk that meets the surface within its steps returns quadmax's own hit, bit for bit."""
-    h = builtin_height(name, (64, 64))
+    """A walk that meets the surface within its steps returns quadmax's own hit, bit for bit (NPOT and 1x1 maps
+    included)."""
+    h = {"npot": npot_height(), "1x1": np.full((1, 1), 0.25)}.get(name)
+    h = builtin_height(name, (64, 64)) if h is None else h
     for angle in (30, 60, 80):
         uv, view = random_rays(512, angle, seed=angle)
         q = probe("quadmax", h, uv, view, S)
