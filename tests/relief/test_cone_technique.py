@@ -143,13 +143,20 @@ def test_footprint_min_depth_bounds_the_bilinear_surface(fmt):
     depth texture's own precision (r16float on adapters without float32 filtering: float64 -> float32 -> float16, as
     the upload converts), NPOT and wrapping included."""
     depth = 1.0 - npot_height()[:40, :56] + np.random.default_rng(3).random((40, 56)) * 1e-4  # float64, off-grid
+    # A double-rounding trap: float32 makes this 0.5 + 2^-12, a float16 tie stored as 0.5; a direct float64 ->
+    # float16 conversion rounds it up to 0.500488, above what the texture holds.
+    depth[6:9, 8:11] = np.maximum(depth[6:9, 8:11], 0.6)
+    depth[7, 9] = 0.5 + 2.0 ** -12 + 2.0 ** -40
     dtype, _ = _TEXEL[fmt]
     stored = _texel_band(depth, dtype, 1)[:, :, 0].astype(np.float64)  # what the texture holds
     low = footprint_min_depth(depth, fmt)
     h, w = depth.shape
     rng = np.random.default_rng(4)
     texel = np.stack([rng.integers(0, w, 20000), rng.integers(0, h, 20000)], -1)
-    uv = (texel + rng.random((20000, 2))) / np.array([w, h])  # a point of each texel's footprint
+    offset = rng.random((20000, 2))  # a point of each texel's footprint ...
+    offset[:2240] = 0.5  # ... and the texel centres, where the surface meets the texel's own value
+    texel[:2240] = np.stack(np.meshgrid(np.arange(w), np.arange(h)), -1).reshape(-1, 2)
+    uv = (texel + offset) / np.array([w, h])
     assert (low[texel[:, 1], texel[:, 0]] <= bilinear(stored, uv)).all()
     # and a local bound, not the map's minimum (which would prove nothing free above the relief's lowest point)
     assert (low > stored.min() + 0.05).mean() > 0.5
@@ -163,18 +170,32 @@ def cells_crossed(uv0, uv1, shape) -> np.ndarray:
     return np.abs(b - a).sum(axis=1)
 
 
+#: Mean fetches per cell border crossed at 85 degrees, pinned over the measured 0.21 (wall: long flat runs) and 0.51
+#: (bumps); on ridges (steep everywhere, narrow cones) the skips save nothing: 1.16.
+SKIP_PAYS = {"wall": 0.3, "bumps": 0.6}
+
+
 @pytest.mark.parametrize("name", ("bumps", "ridges", "wall"))
 def test_every_step_crosses_a_cell_border(gpu, name):
-    """Per ray, fetches <= 2 per cell border crossed up to the hit (+ the first cell and a bracket's finish): no
-    step stays inside a cell, so no ray crawls onto the surface."""
+    """Every step leaves its cell, so a ray takes at most one step per cell border B it crosses up to the hit (+ the
+    first cell), each of at most 2 fetches; a ray whose cone step ended in the relief also pays for the cell that
+    step landed in (past the hit), its halvings and finish cells. And where the relief leaves room the cone skips
+    pay: fewer fetches than cell borders at 85 degrees (SKIP_PAYS)."""
     h = height_map(name, (128, 128))
     for angle in (45, 80, 85):
         uv, view = random_rays(1024, angle, seed=6)
         got = probe("cone", h, uv, view, 0.05)
         ref = exact_hit(1.0 - h, uv, view, 0.05)
+        assert got.capped.mean() < 0.01, angle
         ok = ~got.capped & ref.valid
-        bound = 2 * (cells_crossed(uv[ok], ref.uv[ok], h.shape) + 1) + CONE_HALVINGS_MAX + CONE_FINISH_CELLS
-        assert (got.fetches[ok] <= bound).all(), (angle, int((got.fetches[ok] > bound).sum()))
+        borders = cells_crossed(uv[ok], ref.uv[ok], h.shape)
+        fetches, bracketed = got.fetches[ok], got.layers[ok] == 1
+        plain = ~bracketed
+        assert (fetches[plain] <= 2 * (borders[plain] + 1)).all(), (angle, int((fetches[plain] > 2 * (borders[plain] + 1)).sum()))
+        bound = 2 * (borders[bracketed] + 2) + CONE_HALVINGS_MAX + CONE_FINISH_CELLS
+        assert (fetches[bracketed] <= bound).all(), angle
+        if angle == 85 and name in SKIP_PAYS:
+            assert fetches.mean() < SKIP_PAYS[name] * borders.mean(), (fetches.mean(), borders.mean())
 
 
 def test_bracket_finish_runs_and_is_exact(gpu):

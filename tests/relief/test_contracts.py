@@ -82,13 +82,20 @@ def test_exact_tracers_never_pass_the_first_hit(gpu, technique, name):
 
 
 def axis_aligned_rays(n: int, angle: float, azimuth: float) -> tuple[np.ndarray, np.ndarray]:
-    """Entry points on texel centres (a line of constant u) and on cell borders (texel corners, cell coordinates
-    x = u * W - 0.5 integral), rays along +-u or +-v: one direction component is 0 up to float64 rounding."""
+    """Rays along +u, +v, -u or -v (azimuth 0, 90, 180, 270: the other direction component 0) on an n-texel
+    map: entries at u = (k + 0.5) / n, where the cell coordinate x = u * n - 0.5 is integral (texel centres: the
+    borders of the bilinear cells, so the ray runs along one), at u = (k + 1) / n (texel corners: cell centres),
+    and the same in v."""
     centres = (np.arange(n) + 0.5) / n
     corners = (np.arange(n) + 1.0) / n
     uv = np.concatenate([np.stack([centres, np.full(n, 0.37)], -1), np.stack([corners, corners[::-1]], -1),
                          np.stack([np.full(n, 0.37), centres], -1)])
-    return uv, view_dir_from_angles(np.full(len(uv), angle), np.full(len(uv), azimuth))
+    s, c = np.sin(np.radians(angle)), np.cos(np.radians(angle))
+    exact = np.array({0.0: (s, 0.0, c), 90.0: (0.0, s, c), 180.0: (-s, 0.0, c), 270.0: (0.0, -s, c)}[azimuth])
+    # each entry twice: the component exactly 0, and as trigonometry leaves it (about 1e-16: it survives float32,
+    # so the ray drifts off the line by rounding; this is the case that once sent walks back)
+    trig = view_dir_from_angles(np.full(len(uv), angle), np.full(len(uv), azimuth))
+    return np.concatenate([uv, uv]), np.concatenate([np.tile(exact, (len(uv), 1)), trig])
 
 
 #: UV error (texels) of an exact tracer's uncapped rays: float32 rounding only.

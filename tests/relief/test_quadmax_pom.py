@@ -94,10 +94,10 @@ def test_grazing_views_keep_the_walk_hit(gpu):
     bound = TECHNIQUES["quadmax_pom"].fetch_bound(TECHNIQUES["quadmax_pom"].defaults())
     for angle in (85.0, 89.0, 89.997, 90.0):  # V.z < 1e-4 (grazing, flagged) from 89.9943 degrees
         uv, view = random_rays(256, angle)
-        walk = probe("quadmax", h, uv, view, S, max_steps=8)
+        walk = probe("quadmax", h, uv, view, S, max_steps=TECHNIQUES["quadmax_pom"].defaults()["skip_steps"])
         got = probe("quadmax_pom", h, uv, view, S)
         assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all() and (got.fetches <= bound).all()
-        # rays the 8-step walk finished (its depth is a hit, not its last free point) keep that hit
+        # rays the cut walk finished (its depth is a hit, not its last free point) keep that hit
         found = probe("quadmax", h, uv, view, S, max_steps=1024).depth == walk.depth
         assert found.any()
         assert np.array_equal(got.depth[found], walk.depth[found]), angle

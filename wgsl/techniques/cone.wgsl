@@ -18,8 +18,8 @@
 // 2. otherwise solve the cell exactly (1 gather) from t to its exit. A root after t is the first hit (a free
 //    point reached by a cone step from a free one makes the whole step free). A root AT t after a cone step
 //    means that step ended inside the relief: go to 4. No root: free up to the exit (t_free).
-// 3. from the cell, cone step with the apex at the cell's lowest corner (<= D(p); q is one of the corners, so it
-//    is never below d_q); the texel is read here only when even the widest stored cone could leave the cell (so
+// 3. from the cell, cone step with the apex at the cell's lowest corner (<= D(p); all four corners lie in q's 3x3
+//    neighbourhood, so it is never below d_q); the texel is read here only when even the widest stored cone could leave the cell (so
 //    rays crawling along the surface pay 1 gather per cell). Go to t_cone if it lies past the cell's exit, else
 //    to the exit (the next cell): every step leaves the cell, no Zeno crawl inside a cell.
 // 4. a cone step [t_free, t] that ended solid holds ONE solid interval [t*, t]: halve it with exact bilinear
@@ -89,7 +89,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
             break;
         }
         t_free = n.t_exit;
-        // The cell's lowest corner bounds D(p) from below (and is at least d_q: q is one of the corners).
+        // The cell's lowest corner bounds D(p) from below (and is at least d_q: the corners lie in q's 3x3).
         let apex = min(min(corners.x, corners.y), min(corners.z, corners.w));
         if texel.x < 0.0 && (apex - t) * widest > (n.t_exit - t) * (k + widest) {
             texel = cone_texel_at(start + t * dir, wh);
