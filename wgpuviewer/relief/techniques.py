@@ -306,10 +306,11 @@ TECHNIQUES: dict[str, Technique] = {
         Technique(
             "cone", "-",
             "Robust relaxed cone stepping (Policarpo & Oliveira's relaxed cone map, conservative for the bilinear "
-            "surface; Bán et al. 2024's rule: never step less than to the cell's border): each step solves the "
-            "current cell exactly and skips on by the cone when that leaves the cell; a cone step that ends in the "
-            "relief is halved to one cell and solved exactly. Never passes a surface.",
-            "per step 1 cell gather + 1 cone-map fetch (skipped where no cone could leave the cell); a bracket "
+            "surface; Bán et al. 2024's rule: never step less than to the cell's border): each step either skips by "
+            "a cone that leaves the current cell (proven free by the texel's footprint minimum) or solves the cell "
+            "exactly and moves on; a cone step that ends in the relief is halved to one cell and solved exactly. "
+            "Never passes a surface.",
+            "1 packed cone texel per skip; 1 gather per solved cell (+ the texel where a cone could leave it); a bracket "
             f"adds up to {CONE_HALVINGS_MAX} halvings and {CONE_FINISH_CELLS} cells: "
             f"at most 2*iterations + {CONE_HALVINGS_MAX + CONE_FINISH_CELLS}",
             ("albedo", "normal", "depth", "cone"),

@@ -15,8 +15,9 @@ struct LayerMarch {
 
 fn layer_march(uv0: vec2f, v: vec3f, lod: f32, t0: f32, n: u32) -> LayerMarch {
     let layer_step = (1.0 - t0) / f32(n);
-    let duv = parallax_span(v) * layer_step;
-    var uv = uv0 - parallax_span(v) * t0;
+    let span = parallax_span(v);
+    let duv = span * layer_step;
+    var uv = uv0 - span * t0;
     var d = depth_at(uv, lod);
     var d_prev = d;
     var i = 0u;
