@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wgpuviewer.core.sampling import bilinear
+from tests.relief.twins import pom_from
 from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
+from wgpuviewer.relief.maps import depth_range
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.techniques import AUTO_CANDIDATES, TECHNIQUES
 from wgpuviewer.textures import builtin_height
@@ -39,37 +40,16 @@ def test_enough_skip_steps_is_quadmax(gpu, name):
         assert np.array_equal(hy.uv[done], q.uv[done]) and np.array_equal(hy.depth[done], q.depth[done])
 
 
-def pom_from(height, uv0, view, t0, n):
-    """float64 POM over [t0, 1] (n layers, bilinear repeat sampling): pom_search's arithmetic."""
-    span = view[:, :2] / view[:, 2:3] * S
-    depth = 1.0 - height
-    step = (1.0 - t0) / n
-    t_hit = np.full(len(uv0), np.nan)
-    prev = None
-    for i in range(n + 1):
-        t = t0 + i * step
-        d = bilinear(depth, uv0 - span * t[:, None])
-        if prev is None:
-            first = t >= d
-            t_hit[first] = t0[first]
-        else:
-            new = np.isnan(t_hit) & (t >= d)
-            after, before = d - t, prev - (t - step)
-            w = np.clip(after / np.where(after - before < -1e-12, after - before, -1.0), 0.0, 1.0)
-            t_hit[new] = (t - w * step)[new]
-        prev = d
-    return t_hit
-
-
 def test_the_finish_is_pom_from_the_last_free_point(gpu):
-    """Rays the skip did not finish: the result is POM over [t_s, 1], t_s = where quadmax's walk stopped."""
+    """Rays the skip did not finish: the result is POM from t_s, where quadmax's walk stopped, to the map's deepest depth."""
     h = builtin_height("bumps", (64, 64))
     uv, view = random_rays(1024, 75, seed=5)
     cut = probe("quadmax", h, uv, view, S, max_steps=3)
     hy = probe("quadmax_pom", h, uv, view, S, skip_steps=3, layers=8)
     rest = cut.capped
     assert rest.mean() > 0.3
-    want = pom_from(h, uv[rest], view[rest], cut.depth[rest].astype(np.float64), 8)
+    want = pom_from(h, uv[rest], view[rest], S, cut.depth[rest].astype(np.float64), 8,
+                    depth_range(1.0 - h, gpu.depth_format))
     close = np.abs(hy.depth[rest] - want) <= 1e-3
     assert close.mean() >= 0.97, close.mean()  # hardware bilinear vs float64 may flip a layer test on a few rays
     assert (hy.depth[rest] >= cut.depth[rest] - 1e-6).all()  # the finish never goes back above the skip's end

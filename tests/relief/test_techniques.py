@@ -10,8 +10,9 @@ import pytest
 
 from maptools.cache import cached_generate
 from maptools.cpu import level_sizes
+from tests.relief.twins import pom_from
 from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
-from wgpuviewer.relief.maps import cell_max_height, maxmip_atlas
+from wgpuviewer.relief.maps import DEPTH_RANGE_SLACK, cell_max_height, depth_range, maxmip_atlas
 from wgpuviewer.relief.output import OUTPUT_MODES, mode_data, mode_picture
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
@@ -252,3 +253,62 @@ def test_cost_scale_bounds_each_search():
     assert TECHNIQUES["pom_adaptive"].cost_scale(TECHNIQUES["pom_adaptive"].defaults()) == 33
     assert TECHNIQUES["relief"].cost_scale({"linear_steps": 16, "binary_steps": 6}) == 23
     assert TECHNIQUES["maxmip"].cost_scale(TECHNIQUES["maxmip"].defaults()) == COMMON_COST_SCALE
+
+
+# --- layer searches march the depth map's range --------------------------------------------------------------
+
+def test_depth_range_is_the_uploaded_maps_range_widened():
+    d = np.array([[0.3, 0.45], [0.6, 0.5]])
+    lo, hi = depth_range(d, "r32float")
+    assert lo == pytest.approx(0.3 - DEPTH_RANGE_SLACK, abs=1e-7) and hi == pytest.approx(0.6 + DEPTH_RANGE_SLACK, abs=1e-7)
+    lo16, hi16 = depth_range(d, "r16float")  # as a float16 texture holds it
+    assert lo16 == float(np.float16(0.3)) - DEPTH_RANGE_SLACK and hi16 == float(np.float16(0.6)) + DEPTH_RANGE_SLACK
+    assert depth_range(np.array([[0.0, 1.0]]), "r32float") == (0.0, 1.0)  # kept in [0, 1]
+    assert depth_range(np.ones((2, 2)), "r16float") == (1.0 - DEPTH_RANGE_SLACK, 1.0)
+
+
+LAYER_SEARCHES = (("steep", {"layers": 16}), ("pom", {"layers": 16}), ("pom_adaptive", {}),
+                  ("relief", {"linear_steps": 16, "binary_steps": 0}), ("auto", {}))
+
+
+@pytest.mark.parametrize("technique,params", LAYER_SEARCHES)
+def test_layer_searches_stay_in_the_maps_depth_range(gpu, technique, params):
+    h = 0.35 + 0.3 * height_map("bumps")  # depths within [0.35, 0.65]
+    lo, hi = depth_range(1.0 - h, gpu.depth_format)
+    for angle in (30, 60, 85):
+        uv, view = random_rays(1024, angle, seed=angle)
+        got = probe(technique, h, uv, view, 0.05, **params)
+        assert (got.depth >= lo - 1e-6).all() and (got.depth <= hi + 1e-6).all()
+
+
+def test_pom_marches_the_range_as_its_float64_twin(gpu):
+    h = 0.35 + 0.3 * height_map("bumps")
+    uv, view = random_rays(1024, 70, seed=2)
+    got = probe("pom", h, uv, view, 0.05, layers=8)
+    want = pom_from(h, uv, view, 0.05, np.zeros(len(uv)), 8, depth_range(1.0 - h, gpu.depth_format))
+    close = np.abs(got.depth - want) <= 1e-3
+    assert close.mean() >= 0.97, close.mean()  # hardware bilinear vs float64 may flip a layer test on a few rays
+
+
+def test_a_map_of_half_the_range_costs_pom_what_half_the_scale_does(gpu):
+    """The layers go where the relief is: a map squeezed into half the depth range at scale S is the same relief as
+    the full map at scale S / 2 below a free layer, so POM's error and layer count match those (before the range,
+    half of the layers were spent where no surface can be)."""
+    h = height_map("bumps")
+    squeezed = 0.25 + 0.5 * h
+    full = measure("pom", h, 70, rays=2048, height_scale=0.025, layers=8)
+    half = measure("pom", squeezed, 70, rays=2048, height_scale=0.05, layers=8)
+    assert half.error_p95 <= 1.15 * full.error_p95 + 0.01, (half.error_p95, full.error_p95)
+    assert abs(half.fetches_mean - full.fetches_mean) <= 0.1 * full.fetches_mean + 0.5
+
+
+@pytest.mark.parametrize("name", ["flat0", "flat1"])
+@pytest.mark.parametrize("technique", ["steep", "pom", "relief"])
+def test_a_flat_maps_range_is_the_slack_alone_and_still_hits(gpu, name, technique):
+    """Edge case: a flat map's range is 2 DEPTH_RANGE_SLACK wide at most (at the floor, only the slack above it)."""
+    h = height_map(name)
+    uv, view = random_rays(512, 80, seed=1)
+    got = probe(technique, h, uv, view, 0.05)
+    ref = exact_hit(1.0 - h, uv, view, 0.05)
+    assert np.isfinite(got.uv).all() and not got.capped.any()
+    assert uv_error_texels(got.uv, ref.uv, h.shape[::-1]).max() <= 0.05

@@ -49,6 +49,23 @@ class MapSlot:
         return self.build is not None
 
 
+#: How far a filtered depth fetch may fall outside the range of the texels it mixes (rounding of the filter
+#: weights and of the format; a float16 step near 1 is 2^-11): ``depth_range`` widens the range by this much.
+DEPTH_RANGE_SLACK = 2.0 ** -10
+
+
+def depth_range(depth: np.ndarray, fmt: str) -> tuple[float, float]:
+    """(lowest, highest) depth of ``depth`` as the depth texture holds it (``fmt``: r32float or r16float, as
+    uploaded), widened by ``DEPTH_RANGE_SLACK`` and kept in [0, 1]: every depth fetch, at any mip level (the levels
+    are averages), lies within it, so the layer searches march only this range (common/trace.wgsl's relief_range).
+    A NaN depth is refused earlier (textures.load_depth)."""
+    d = np.asarray(depth, np.float32)  # the upload's path: float32 first, then the texture's format
+    if fmt == "r16float":
+        d = d.astype(np.float16).astype(np.float32)
+    lo, hi = float(d.min()), float(d.max())
+    return max(0.0, lo - DEPTH_RANGE_SLACK), min(1.0, hi + DEPTH_RANGE_SLACK)
+
+
 def _depth(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
     return create_texture(gpu, mip_chain(depth), gpu.depth_format, label)
 

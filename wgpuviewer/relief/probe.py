@@ -22,7 +22,7 @@ from maptools import validate_height
 from wgpuviewer.core.errors import InputError
 from wgpuviewer.core.gpu import Gpu, get_gpu
 
-from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_entries
+from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
 from .shaders import compose_technique, pack_trace_params
 from .techniques import TECHNIQUES, get_technique, resolve_params
 
@@ -194,7 +194,8 @@ def material_bind_group(gpu: Gpu, layout, tech, height: np.ndarray, height_scale
     built from ``height`` as the renderer builds them, and ``extra`` (binding, texture) pairs."""
     device = gpu.device
     params_buf = device.create_buffer_with_data(
-        label="probe:params", data=pack_trace_params(tech, height_scale, height.shape, values),
+        label="probe:params", data=pack_trace_params(tech, height_scale, height.shape, values,
+                                                     depth_range(1.0 - height, gpu.depth_format)),
         usage=wgpu.BufferUsage.UNIFORM,
     )
     depth = 1.0 - height

@@ -37,7 +37,7 @@ from .filters import (
     resolve_filter_params,
     sampler_descriptor,
 )
-from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, layout_entries
+from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
 from .probe import probe
 from .shaders import MAX_LIGHTS, compose_technique, pack_trace_params, trace_params_size
 from .techniques import AUTO_CANDIDATES, Technique, get_technique, resolve_params
@@ -133,8 +133,10 @@ class Renderer:
             self._textures, self._pipelines, self._material_layouts = like._textures, like._pipelines, like._material_layouts
             self._frame_layout, self._object_layout, self._sampler = like._frame_layout, like._object_layout, like._sampler
             self._filter_layout, self._samplers = like._filter_layout, like._samplers
+            self._depth_ranges = like._depth_ranges
         else:
             self._textures: dict[tuple[str, str], wgpu.GPUTexture] = {}
+            self._depth_ranges: dict[str, tuple[float, float]] = {}
             self._pipelines: dict[tuple, wgpu.GPURenderPipeline] = {}
             self._material_layouts: dict[tuple[str, ...], wgpu.GPUBindGroupLayout] = {}
             self._frame_layout = device.create_bind_group_layout(
@@ -218,6 +220,13 @@ class Renderer:
                 del data
             self.created.append(f"texture:{label}")
         return self._textures[key]
+
+    def depth_range(self, material_name: str) -> tuple[float, float]:
+        """The range of a material's depth texture (maps.depth_range), computed once."""
+        if material_name not in self._depth_ranges:
+            material = self.scene.materials[material_name]
+            self._depth_ranges[material_name] = depth_range(self._depth_data(material), self.gpu.depth_format)
+        return self._depth_ranges[material_name]
 
     def auto_table(self, material_name: str) -> np.ndarray:
         """auto's measurements on a material (relief/autotable.py): from the disk cache once auto has drawn it."""
@@ -427,9 +436,10 @@ class Renderer:
             group, params_buffer = self._material_group(material_name, technique, draw)
             material = self.scene.materials[material_name]
             depth_shape = self.texture(material_name, "depth").size[1::-1] if technique.needs_depth else (1, 1)
+            depth_range = self.depth_range(material_name) if technique.needs_depth else (0.0, 1.0)
             height_scale = material.height_scale if draw.height_scale is None else draw.height_scale
             self.gpu.device.queue.write_buffer(
-                params_buffer, 0, pack_trace_params(technique, height_scale, depth_shape, params)
+                params_buffer, 0, pack_trace_params(technique, height_scale, depth_shape, params, depth_range)
             )
             groups[material_name] = group
         background = [*self.scene.background, 0.0]

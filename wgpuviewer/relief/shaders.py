@@ -80,11 +80,14 @@ def trace_params_size(technique: Technique) -> int:
     return 4 * (n + (-n % 4))
 
 
-def pack_trace_params(technique: Technique, height_scale: float, depth_shape: tuple, params: dict) -> np.ndarray:
+def pack_trace_params(technique: Technique, height_scale: float, depth_shape: tuple, params: dict,
+                      depth_range: tuple[float, float] = (0.0, 1.0)) -> np.ndarray:
     """TraceParams uniform data for ``technique`` (field order of ``Technique.trace_fields``; booleans as 0/1).
-    ``params`` holds the parameter values (missing ones take the registry defaults)."""
+    ``params`` holds the parameter values (missing ones take the registry defaults); ``depth_range`` is the depth
+    map's (maps.depth_range; the default claims nothing about the map)."""
     values = {**technique.defaults(), **params, **dict(technique.fixed),
-              "height_scale": height_scale, "depth_width": depth_shape[1], "depth_height": depth_shape[0]}
+              "height_scale": height_scale, "depth_width": depth_shape[1], "depth_height": depth_shape[0],
+              "depth_min": depth_range[0], "depth_max": depth_range[1]}
     data = np.zeros(trace_params_size(technique) // 4, np.float32)
     for i, name in enumerate(technique.trace_fields):
         data[i] = float(values[name])

@@ -17,7 +17,9 @@ from wgpuviewer.core.errors import UserError
 
 #: The first fields of every technique's ``TraceParams`` uniform (f32): the material's relief depth and the
 #: depth map's size in texels (for the mip level). The technique's parameters and fixed values follow.
-COMMON_TRACE_FIELDS = ("height_scale", "depth_width", "depth_height")
+#: TraceParams fields every technique has: the material's relief scale, its depth map's size and depth range
+#: (maps.depth_range: the layer searches march only that range, common/trace.wgsl's relief_range).
+COMMON_TRACE_FIELDS = ("height_scale", "depth_width", "depth_height", "depth_min", "depth_max")
 
 #: Full heat of the cost view for techniques without a layer bound (fetches per pixel).
 COMMON_COST_SCALE = 64.0

@@ -28,6 +28,16 @@ fn parallax_span(v: vec3f) -> vec2f {
     return v.xy / max(v.z, MIN_VIEW_Z) * trace_params.height_scale;
 }
 
+// The depth interval a search along the ray needs, from t0 on: [max(t0, depth_min), depth_max], the depth map's
+// range (the renderer and the probe pass the uploaded map's lowest and highest depth, widened by the filtering
+// slack, maps.depth_range). Above depth_min the ray is above every point of the surface and at depth_max it is at
+// or below all of them, so a layer outside the range can only miss: a map that spans half the depth range gets
+// twice the layers where its relief is. (0, 1) for a map that spans it all.
+fn relief_range(t0: f32) -> vec2f {
+    let lo = clamp(max(t0, trace_params.depth_min), 0.0, 1.0);
+    return vec2f(lo, clamp(trace_params.depth_max, lo, 1.0));
+}
+
 fn untraced(uv: vec2f) -> TraceResult {
     return TraceResult(uv, 0.0, 0u, false, 0u);
 }

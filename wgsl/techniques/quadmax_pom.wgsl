@@ -1,7 +1,7 @@
 // quadmax_pom: a bounded conservative skip, then a short POM search (the quadtree-displacement idea; issue 13's
 // hybrid). The skip is quadmax's walk (common/quadmax.wgsl) cut after skip_steps steps: if it meets the surface
 // within them its hit is quadmax's (exact on the packed leaves); otherwise it stops at a point t_s it proved free
-// (everything before it is free too) and POM marches `layers` equal layers of [t_s, 1] from there, then
+// (everything before it is free too) and POM marches `layers` equal layers of [t_s, depth_max] from there, then
 // interpolates linearly. APPROXIMATE: the march can step over a feature thinner than a layer, and the
 // interpolation is a secant of the sampled surface; its error is measured (probe, benchmark), not bounded.
 // Why: the skip removes the empty part of the ray at a bounded cost (no divergent long walk), so the layers
