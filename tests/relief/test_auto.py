@@ -25,6 +25,21 @@ def table_of(height: np.ndarray, height_scale: float = 0.05) -> np.ndarray:
     return autotable.measure(1.0 - np.asarray(height, np.float32), height_scale, probe)
 
 
+def test_pom_layers_keep_the_horizontal_spacing_inside_a_bin():
+    edges = autotable.edge_angles()
+    for n in (4, 16, 64):
+        lower = autotable.lower_edge_layers(n)
+        assert lower == int(np.ceil(n / np.sqrt(2)))
+        for b in range(1, len(edges) - 1):
+            inside = np.linspace(edges[b], edges[b + 1], 50)[1:-1]
+            got = autotable.pom_layers(n, inside)
+            assert got.min() >= lower and got.max() <= n and (np.diff(got) >= 0).all()
+            tan = np.tan(np.radians(inside))
+            assert (got >= n * tan / np.tan(np.radians(edges[b + 1])) - 1e-9).all()  # never wider-spaced than at the edge
+            assert autotable.pom_layers(n, edges[b] + 1e-9) == lower
+        assert autotable.pom_layers(n, 0.0) == n and autotable.pom_layers(n, 89.9) == n  # bin 0, last bin: as is
+
+
 def test_bins_and_budget_levels():
     edges = autotable.edge_angles()
     assert edges[0] == 0 and np.all(np.diff(edges) > 0) and 88 < edges[-1] < 89
@@ -55,9 +70,21 @@ def test_the_shader_picks_the_tables_choice_and_runs_the_candidates_code(gpu):
             if name == "basic":
                 np.testing.assert_array_equal(got.uv[rays], uv[rays].astype(np.float32))
                 continue
-            alone = probe(name, h, uv[rays], view[rays], 0.05, **params)
-            np.testing.assert_array_equal(got.uv[rays], alone.uv)
-            np.testing.assert_array_equal(got.fetches[rays], alone.fetches)
+            if name != "pom":
+                alone = probe(name, h, uv[rays], view[rays], 0.05, **params)
+                np.testing.assert_array_equal(got.uv[rays], alone.uv)
+                np.testing.assert_array_equal(got.fetches[rays], alone.fetches)
+                continue
+            # POM runs the count scaled with tan inside the bin (autotable.pom_layers, in float64 here)
+            layers = autotable.pom_layers(params["layers"], angles[rays])
+            assert layers.min() >= autotable.lower_edge_layers(params["layers"]) and layers.max() <= params["layers"]
+            same = np.zeros(rays.sum(), bool)
+            for n in np.unique(layers):
+                sub = layers == n
+                alone = probe("pom", h, uv[rays][sub], view[rays][sub], 0.05, layers=int(n))
+                same[sub] = (got.uv[rays][sub] == alone.uv).all(axis=1) & (got.fetches[rays][sub] == alone.fetches)
+            # float32 tan may round a ray sitting on a count's boundary to the neighbouring count
+            assert same.mean() > 0.995, (max_error, params, same.mean())
 
 
 BUDGET_MAPS = ("bricks", "bumps", "ridges", "flat0", "flat1", "spike", "step", "wall", "checker")
@@ -96,7 +123,8 @@ def test_npot_map_and_a_larger_relief(gpu):
 def test_the_table_is_measured_once_then_read_from_the_cache(gpu):
     h = builtin_height("ridges", (32, 32))
     first = table_of(h)
-    assert first.shape == (len(AUTO_CANDIDATES), len(autotable.edge_angles()), len(autotable.FIELDS))
+    assert first.shape == (len(AUTO_CANDIDATES) + len(autotable.SCALED), len(autotable.edge_angles()),
+                           len(autotable.FIELDS))
 
     def no_probe(*args, **kwargs):
         raise AssertionError("the cached table should have been used")

@@ -13,6 +13,12 @@ the map); its cost there is the larger SIMD-tile cost of the two edges times ``C
 its fetches in POM fetches). Where no candidate meets the budget, the most accurate one is used and the table says
 so (its error channel exceeds the budget).
 
+POM's layer count scales with tan(angle) inside a bin (``pom_layers``, auto.wgsl's auto_pom_layers): a candidate's
+count n holds at the bin's upper edge, and below it the count that keeps the layers' horizontal spacing, down to
+``lower_edge_layers(n)`` at the lower edge. So the table measures every POM candidate twice per angle: with n (for
+the bin that ends there) and with ``lower_edge_layers(n)`` (for the bin that starts there; rows after the candidates,
+``SCALED``).
+
 The measurements are cached on disk next to maptools' maps (content hash of the depth map + height scale +
 candidates, their WGSL code, the rays; ``maptools.cache``'s key and folder, kind ``auto_table``). This module gets
 the probe from its caller (maps.py's slot is "measured": the renderer and the probe pass ``probe.probe``), so it
@@ -45,7 +51,10 @@ from .techniques import (
 )
 
 #: Bump when what ``measure`` computes changes (cached tables are then measured again).
-VERSION = 2
+VERSION = 3
+#: The POM candidates (indices into AUTO_CANDIDATES) whose scaled lower-edge count is measured too: table row
+#: len(AUTO_CANDIDATES) + k holds candidate SCALED[k] run with ``lower_edge_layers`` of its count.
+SCALED = tuple(c for c, (name, _) in enumerate(AUTO_CANDIDATES) if name == "pom")
 ERROR_RAYS = 1024  # independent random rays per angle for the error
 TILES = 16  # screen tiles per angle for the cost
 TILE = (8, 4)  # rays per tile: across x along the view azimuth, like a SIMD group of 8 x 4 pixels
@@ -73,6 +82,22 @@ def bin_of(angle_deg) -> np.ndarray:
     with np.errstate(divide="ignore"):
         b = np.floor(AUTO_BINS_PER_OCTAVE * np.log2(np.maximum(tan, 1e-300) / AUTO_TAN0)) + 1
     return np.clip(np.where(tan < AUTO_TAN0, 0, b), 0, AUTO_BINS - 1).astype(np.int64)
+
+
+def lower_edge_layers(n: int) -> int:
+    """POM's count at a bin's lower edge for table count n (auto.wgsl: ceil(n tan / tan_hi) with tan / tan_hi =
+    2^(-1/k) there; n 2^(-1/k) is never an integer, so float32 rounding cannot change the ceiling)."""
+    return max(1, math.ceil(n * 2.0 ** (-1.0 / AUTO_BINS_PER_OCTAVE)))
+
+
+def pom_layers(n: int, angle_deg) -> np.ndarray:
+    """auto.wgsl's POM layer count for table count n at view angles (degrees), in float64: n in bin 0 and the last
+    bin; inside bins 1 .. AUTO_BINS - 2, ceil(n tan / tan_hi), tan_hi the bin's upper edge, clamped to [1, n]."""
+    angle = np.asarray(angle_deg, np.float64)
+    b = bin_of(angle)
+    tan_hi = AUTO_TAN0 * 2.0 ** (b / AUTO_BINS_PER_OCTAVE)
+    scaled = np.clip(np.ceil(n * np.tan(np.radians(angle)) / tan_hi), 1, n)
+    return np.where((b >= 1) & (b < AUTO_BINS - 1), scaled, n).astype(np.int64)
 
 
 def budgets() -> np.ndarray:
@@ -110,9 +135,10 @@ def _measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndar
     per_angle = n_err + n_cost
     error_rays = (np.arange(len(uv)) % per_angle) < n_err
     ref = exact_hit(depth, uv[error_rays], view[error_rays], height_scale)
-    out = np.zeros((len(AUTO_CANDIDATES), len(angles), len(FIELDS)))
+    runs = [*AUTO_CANDIDATES, *(("pom", {"layers": lower_edge_layers(AUTO_CANDIDATES[c][1]["layers"])}) for c in SCALED)]
+    out = np.zeros((len(runs), len(angles), len(FIELDS)))
     height = 1.0 - np.asarray(depth, np.float64)
-    for c, (name, params) in enumerate(AUTO_CANDIDATES):
+    for c, (name, params) in enumerate(runs):
         if TECHNIQUES[name].ray_search:
             got = probe(name, height, uv, view, height_scale, **params)
             hit_uv, fetches, capped = got.uv.astype(np.float64), got.fetches.astype(np.float64), got.capped
@@ -139,8 +165,8 @@ def candidates_code() -> str:
 
 
 def measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndarray:
-    """The measurements (candidates, angles, FIELDS) of ``depth`` (D = 1 - height) at ``height_scale``, from the disk
-    cache when it holds them."""
+    """The measurements (candidates + SCALED rows, angles, FIELDS) of ``depth`` (D = 1 - height) at ``height_scale``,
+    from the disk cache when it holds them."""
     d = np.ascontiguousarray(depth, np.float32)
     options = {"height_scale": float(height_scale), "candidates": [[n, p] for n, p in AUTO_CANDIDATES],
                "code": candidates_code(),
@@ -150,7 +176,7 @@ def measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndarr
     if path.is_file():
         try:
             table = np.load(path, allow_pickle=False)
-            if table.shape == (len(AUTO_CANDIDATES), len(edge_angles()), len(FIELDS)):
+            if table.shape == (len(AUTO_CANDIDATES) + len(SCALED), len(edge_angles()), len(FIELDS)):
                 return table
         except (OSError, ValueError):  # a damaged cache entry is measured again
             pass
@@ -163,13 +189,19 @@ def measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndarr
 def choose(table: np.ndarray) -> np.ndarray:
     """Per (budget level, bin): (candidate index, error at the worse edge, weighted cost, met) as float64
     (AUTO_BUDGET_LEVELS, AUTO_BINS, 4)."""
+    n = len(AUTO_CANDIDATES)
     err, simd = table[:, :, FIELDS.index("err_p975")], table[:, :, FIELDS.index("fetches_simd")]
     weights = np.array([COST_WEIGHTS[name] for name, _ in AUTO_CANDIDATES])[:, None]
     # bin b spans edges b and b + 1 (edge 0 = angle 0); the last bin is open-ended: its lower edge only
     lo = np.arange(AUTO_BINS)
     hi = np.minimum(lo + 1, AUTO_BINS - 1)
-    bin_err = np.maximum(err[:, lo], err[:, hi])
-    bin_cost = weights * np.maximum(simd[:, lo], simd[:, hi])
+    err_lo, simd_lo = err[:n, lo].copy(), simd[:n, lo].copy()
+    scaled = (lo >= 1) & (lo < AUTO_BINS - 1)  # bins whose lower edge runs POM's scaled count (pom_layers)
+    for k, c in enumerate(SCALED):
+        err_lo[c, scaled] = err[n + k, lo[scaled]]
+        simd_lo[c, scaled] = simd[n + k, lo[scaled]]
+    bin_err = np.maximum(err_lo, err[:n, hi])
+    bin_cost = weights * np.maximum(simd_lo, simd[:n, hi])
     out = np.zeros((AUTO_BUDGET_LEVELS, AUTO_BINS, 4))
     for j, budget in enumerate(budgets()):
         for b in range(AUTO_BINS):
@@ -220,7 +252,11 @@ def describe(table: np.ndarray, max_error: float) -> list[str]:
         hi = f"{edges[end + 1]:.1f}°" if end + 1 < AUTO_BINS else "90°"
         worst = float(choice[b:end + 1, 1].max())
         met = "" if choice[b:end + 1, 3].all() else " (budget not met)"
-        lines.append(f"{lo:.1f}-{hi}: {candidate_label(int(choice[b, 0]))}, p97.5 <= {worst:.3g} texel, "
+        label = candidate_label(int(choice[b, 0]))
+        name, params = AUTO_CANDIDATES[int(choice[b, 0])]
+        if name == "pom" and b >= 1 and end < AUTO_BINS - 1:  # scaled with tan inside each bin (pom_layers)
+            label = f"pom layers={lower_edge_layers(params['layers'])}-{params['layers']} by angle"
+        lines.append(f"{lo:.1f}-{hi}: {label}, p97.5 <= {worst:.3g} texel, "
                      f"cost <= {float(choice[b:end + 1, 2].max()):.3g}{met}")
         b = end + 1
     return lines

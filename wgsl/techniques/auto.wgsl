@@ -2,7 +2,8 @@
 // then bins_per_octave bins per octave of tan(angle), the last one open-ended; grazing views take the last);
 // max_error picks a budget level (the largest 2^(budget_log2_min + j) not above it). The table
 // (relief/autotable.py: measured by the probe on this material's height map) holds per (bin, level) the
-// cheapest candidate within the budget: its index, method, parameter and measured error. The candidates are the
+// cheapest candidate within the budget: its index, method, parameter and measured error (a POM count holds at
+// the bin's upper edge and is scaled with tan(angle) inside the bin: auto_pom_layers). The candidates are the
 // very code the techniques basic, parallax, pom and quadmax run (common/*.wgsl). `layers` reports the chosen
 // candidate (1-based, cheapest first) for the layers debug view. The table texel is not counted as a fetch.
 // #include "common/layer_march.wgsl"
@@ -13,11 +14,20 @@ const AUTO_BASIC: u32 = 0u;
 const AUTO_PARALLAX: u32 = 1u;
 const AUTO_POM: u32 = 2u;
 
-fn auto_choice(v: vec3f) -> vec4f {
+// The table texel for a view (texel: candidate index, method, parameter, measured error), with the view's bin and
+// tan(angle) for the POM layer count.
+struct AutoPick {
+    texel: vec4f,
+    bin: i32,
+    tan_view: f32,
+}
+
+fn auto_pick(v: vec3f) -> AutoPick {
     let dims = vec2i(textureDimensions(auto_table_tex, 0));  // (bins, budget levels)
     var bin = dims.x - 1;
+    var tan_view = 0.0;
     if !is_grazing(v) {
-        let tan_view = length(v.xy) / v.z;
+        tan_view = length(v.xy) / v.z;
         if tan_view < trace_params.bin_tan0 {
             bin = 0;
         } else {
@@ -27,12 +37,26 @@ fn auto_choice(v: vec3f) -> vec4f {
     }
     let budget = clamp(trace_params.max_error, MAX_ERROR_MIN, MAX_ERROR_MAX);
     let level = i32(clamp(floor(log2(budget)) - trace_params.budget_log2_min, 0.0, f32(dims.y - 1)));
-    return textureLoad(auto_table_tex, vec2i(bin, level), 0);
+    return AutoPick(textureLoad(auto_table_tex, vec2i(bin, level), 0), bin, tan_view);
+}
+
+// POM's layer count: the table's count n holds at the upper edge of the bin; below it the count that keeps the
+// layers' horizontal spacing (what decides which features a layer steps over), ceil(n tan / tan_hi), down to
+// ceil(n 2^(-1/k)) at the lower edge, where the table measured exactly that count (relief/autotable.py pom_layers).
+// Bin 0 and the open-ended last bin run n as it is.
+fn auto_pom_layers(pick: AutoPick) -> u32 {
+    let n = clamp(pick.texel.z, 1.0, f32(MAX_LAYERS));
+    if pick.bin < 1 || pick.bin >= i32(textureDimensions(auto_table_tex, 0).x) - 1 {
+        return u32(n);
+    }
+    let tan_hi = trace_params.bin_tan0 * exp2(f32(pick.bin) / trace_params.bins_per_octave);
+    return u32(clamp(ceil(n * pick.tan_view / tan_hi), 1.0, n));
 }
 
 fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     fetch_count = 0u;
-    let choice = auto_choice(v);
+    let pick = auto_pick(v);
+    let choice = pick.texel;
     var r: TraceResult;
     switch u32(choice.y) {
         case AUTO_BASIC: {
@@ -42,7 +66,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
             r = parallax_offset(uv0, v, lod, false);
         }
         case AUTO_POM: {
-            r = pom_search(uv0, v, lod, 0.0, u32(clamp(choice.z, 1.0, f32(MAX_LAYERS))));
+            r = pom_search(uv0, v, lod, 0.0, auto_pom_layers(pick));
         }
         default: {
             r = quadmax_search(uv0, v, choice.z, u32(trace_params.quadmax_steps));
