@@ -312,3 +312,24 @@ def test_a_flat_maps_range_is_the_slack_alone_and_still_hits(gpu, name, techniqu
     ref = exact_hit(1.0 - h, uv, view, 0.05)
     assert np.isfinite(got.uv).all() and not got.capped.any()
     assert uv_error_texels(got.uv, ref.uv, h.shape[::-1]).max() <= 0.05
+
+
+def test_the_renderer_marches_the_materials_range(gpu, tmp_path):
+    """Drawn, not only probed: steep's hit depths sit on its layer grid over the material's depth range."""
+    from PIL import Image
+
+    from tests.relief.scenes import material_scene
+    from wgpuviewer.scene import parse_scene
+
+    height = 0.35 + 0.3 * height_map("bumps")  # depths within [0.35, 0.65]: a range of 0.3 at most
+    Image.fromarray(np.round(height * 65535).astype(np.uint16)).save(tmp_path / "h.png")
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text(material_scene(["steep"], 'albedo = [0.8, 0.8, 0.8]\nheight = "h.png"\nheight_scale = 0.05',
+                                         position=(0.3, 0.8, 1.2)))
+    renderer = Renderer(parse_scene(scene_path.read_text(), scene_path), gpu)
+    image = renderer.render(renderer.config("steep", {"layers": 8}), (48, 32))
+    depth = mode_data(image, "depth")[image.covered]
+    lo, hi = renderer.depth_range("m")
+    assert np.allclose((lo, hi), depth_range(1.0 - height, gpu.depth_format), atol=1e-4)  # (16-bit PNG)
+    k = (depth - lo) / ((hi - lo) / 8)
+    assert depth.size > 500 and np.abs(k - np.round(k)).max() < 1e-3 and k.min() > -1e-3

@@ -206,6 +206,8 @@ class Renderer:
             slot = MAP_SLOTS[kind]
             if slot.derived:
                 depth = self._depth_data(material)
+                if material_name not in self._depth_ranges:  # while the depth is loaded anyway
+                    self._depth_ranges[material_name] = depth_range(depth, self.gpu.depth_format)
                 measured = (probe,) if slot.measured else ()  # auto's table: measured with the probe
                 with _reported_against_height(material, kind):
                     self._textures[key] = slot.build(self.gpu, depth, material.height_scale, label, *measured)
