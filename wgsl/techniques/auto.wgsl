@@ -14,11 +14,12 @@ const AUTO_BASIC: u32 = 0u;
 const AUTO_PARALLAX: u32 = 1u;
 const AUTO_POM: u32 = 2u;
 
-// The table texel for a view (texel: candidate index, method, parameter, measured error), with the view's bin and
-// tan(angle) for the POM layer count.
+// The table texel for a view (texel: candidate index, method, parameter, measured error), with the view's bin, the
+// table's bin count and tan(angle) for the POM layer count.
 struct AutoPick {
     texel: vec4f,
     bin: i32,
+    bins: i32,
     tan_view: f32,
 }
 
@@ -37,7 +38,7 @@ fn auto_pick(v: vec3f) -> AutoPick {
     }
     let budget = clamp(trace_params.max_error, MAX_ERROR_MIN, MAX_ERROR_MAX);
     let level = i32(clamp(floor(log2(budget)) - trace_params.budget_log2_min, 0.0, f32(dims.y - 1)));
-    return AutoPick(textureLoad(auto_table_tex, vec2i(bin, level), 0), bin, tan_view);
+    return AutoPick(textureLoad(auto_table_tex, vec2i(bin, level), 0), bin, dims.x, tan_view);
 }
 
 // POM's layer count: the table's count n holds at the upper edge of the bin; below it the count that keeps the
@@ -46,7 +47,7 @@ fn auto_pick(v: vec3f) -> AutoPick {
 // Bin 0 and the open-ended last bin run n as it is.
 fn auto_pom_layers(pick: AutoPick) -> u32 {
     let n = clamp(pick.texel.z, 1.0, f32(MAX_LAYERS));
-    if pick.bin < 1 || pick.bin >= i32(textureDimensions(auto_table_tex, 0).x) - 1 {
+    if pick.bin < 1 || pick.bin >= pick.bins - 1 {
         return u32(n);
     }
     let tan_hi = trace_params.bin_tan0 * exp2(f32(pick.bin) / trace_params.bins_per_octave);
