@@ -58,7 +58,7 @@ def depth_range(depth: np.ndarray, fmt: str) -> tuple[float, float]:
     """(lowest, highest) depth of ``depth`` as the depth texture holds it (``fmt``: r32float or r16float, as
     uploaded), widened by ``DEPTH_RANGE_SLACK`` and kept in [0, 1]: every depth fetch, at any mip level (the levels
     are averages), lies within it, so the layer searches march only this range (common/trace.wgsl's relief_range).
-    A NaN depth is refused earlier (textures.load_depth)."""
+    Non-finite depths never get here: the height readers and the probe refuse them."""
     d = np.asarray(depth, np.float32)  # the upload's path: float32 first, then the texture's format
     if fmt == "r16float":
         d = d.astype(np.float16).astype(np.float32)
