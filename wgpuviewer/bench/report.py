@@ -483,11 +483,13 @@ def plots(out: Path, values: list[dict]) -> tuple[list[str], str | None]:
             ax.scatter(x, y, color=colors[k[0]], s=14)
         front = pareto_front(pts)
         ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=0.8)
-        for i in front:
-            ax.annotate(_label(keys[i]).replace("layers=", ""), pts[i], fontsize=6, xytext=(3, 3),
-                        textcoords="offset points")
+        for n, i in enumerate(sorted(front, key=lambda i: pts[i][0])):
+            # neighbours along the front alternate above and below their point, so their labels do not overlap
+            ax.annotate(_label(keys[i]).replace("layers=", ""), pts[i], fontsize=6,
+                        xytext=(4, 3 if n % 2 == 0 else -9), textcoords="offset points")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        _plain_ratio_ticks(ax.xaxis, [x for x, _ in pts])
         ax.set_title(m, fontsize=9)
         ax.set_xlabel("GPU time / basic (mean over angles)", fontsize=7)
         ax.set_ylabel("p95 UV error, texels (mean over angles)", fontsize=7)
@@ -541,6 +543,18 @@ def plots(out: Path, values: list[dict]) -> tuple[list[str], str | None]:
         plt.close(fig)
         written.append("cost_vs_time.png")
     return written, None
+
+
+def _plain_ratio_ticks(axis, values) -> None:
+    """Ticks of a log axis of time ratios as plain numbers (1, 1.5, 2, 3, ...) instead of powers of ten."""
+    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator, ScalarFormatter
+
+    lo, hi = min(values), max(values)
+    ticks = [t for t in (1, 1.5, 2, 3, 4, 6, 8, 10, 15, 20, 30, 40, 60, 80, 100) if lo / 1.3 <= t <= hi * 1.3]
+    axis.set_major_locator(FixedLocator(ticks or [1]))
+    axis.set_major_formatter(ScalarFormatter())
+    axis.set_minor_locator(NullLocator())
+    axis.set_minor_formatter(NullFormatter())
 
 
 def _save(fig, path: Path) -> None:
