@@ -7,9 +7,11 @@ import math
 
 import numpy as np
 import pytest
+from PIL import Image
 
 from maptools.cache import cached_generate
 from maptools.cpu import level_sizes
+from tests.relief.scenes import material_scene
 from tests.relief.twins import pom_from
 from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
 from wgpuviewer.relief.maps import DEPTH_RANGE_SLACK, cell_max_height, depth_range, maxmip_atlas
@@ -18,7 +20,7 @@ from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS, TECHNIQUES
-from wgpuviewer.scene import default_scene_path, load_scene
+from wgpuviewer.scene import default_scene_path, load_scene, parse_scene
 from wgpuviewer.textures import builtin_height
 
 REAL = ("bricks", "bumps", "ridges")
@@ -316,11 +318,6 @@ def test_a_flat_maps_range_is_the_slack_alone_and_still_hits(gpu, name, techniqu
 
 def test_the_renderer_marches_the_materials_range(gpu, tmp_path):
     """Drawn, not only probed: steep's hit depths sit on its layer grid over the material's depth range."""
-    from PIL import Image
-
-    from tests.relief.scenes import material_scene
-    from wgpuviewer.scene import parse_scene
-
     height = 0.35 + 0.3 * height_map("bumps")  # depths within [0.35, 0.65]: a range of 0.3 at most
     Image.fromarray(np.round(height * 65535).astype(np.uint16)).save(tmp_path / "h.png")
     scene_path = tmp_path / "scene.toml"
