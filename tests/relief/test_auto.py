@@ -13,7 +13,7 @@ from wgpuviewer.relief.accuracy import npot_height, random_rays
 from wgpuviewer.relief.output import mode_data
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
-from wgpuviewer.relief.renderer import Renderer, layer_range
+from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.relief.techniques import AUTO_CANDIDATES, AUTO_TAN0, TECHNIQUES
 from wgpuviewer.scene import load_scene
 from wgpuviewer.textures import builtin_height
@@ -150,7 +150,7 @@ def test_debug_view_and_registry_entry(gpu):
     tech = TECHNIQUES["auto"]
     assert tech.ray_search and not tech.exact and "auto_table" in tech.textures
     assert tech.fetch_bound(tech.defaults()) >= TECHNIQUES["quadmax"].fetch_bound(TECHNIQUES["quadmax"].defaults())
-    assert layer_range(tech.defaults()) == (1.0, float(len(AUTO_CANDIDATES)))
+    assert tech.layer_range(tech.defaults()) == (1.0, float(len(AUTO_CANDIDATES)))
     renderer = Renderer(load_scene(GOLDEN / "scene.toml"), gpu)
     image = renderer.render("auto", (96, 54))
     chosen = mode_data(image, "layers")[image.covered]

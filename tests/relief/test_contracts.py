@@ -1,8 +1,10 @@
 """What every ray-search technique of the registry promises, tested for each one automatically (a new technique
-gets these tests by being registered): finite results at grazing views, flagged results for views with V.z = 0
-and back-facing ones, fetch counts within the technique's declared bound, and for exact tracers never a hit
-behind the float64 first hit, and the hit itself on axis-aligned rays along texel-centre lines and cell borders (where
-a position rounds into the neighbouring cell). Technique test files keep only their own claims."""
+gets these tests by being registered), at its defaults and at each of its ``contract_params``: finite results at
+grazing views, flagged results for views with V.z = 0 and back-facing ones, fetch counts within the technique's
+declared bound, and for exact tracers never a hit behind the float64 first hit; at the defaults, the exact tracers'
+hit itself on axis-aligned rays along texel-centre lines and cell borders (where a position rounds into the
+neighbouring cell). Every entry declares this coverage (contract parameters or the reason it needs none, accuracy
+settings, its cost and layers view scales). Technique test files keep only their own claims."""
 
 from __future__ import annotations
 
@@ -12,7 +14,7 @@ import pytest
 from wgpuviewer.relief.accuracy import random_rays
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
-from wgpuviewer.relief.techniques import TECHNIQUES
+from wgpuviewer.relief.techniques import TECHNIQUES, resolve_params
 from wgpuviewer.textures import builtin_height
 
 RAY_SEARCH = [name for name, t in TECHNIQUES.items() if t.ray_search]
@@ -26,56 +28,73 @@ def height_map(name: str) -> np.ndarray:
     return builtin_height(name, (64, 64))
 
 
-def test_every_ray_search_declares_a_fetch_bound():
+def settings(names: list[str]) -> list:
+    """(technique, parameter overrides) cases: each technique's defaults, then each of its contract_params."""
+    return [pytest.param(name, params, id=f"{name}-" + ("-".join(f"{k}={v}" for k, v in params.items()) or "defaults"))
+            for name in names for params in ({}, *TECHNIQUES[name].contract_params)]
+
+
+def bound(technique: str, params: dict) -> int:
+    t = TECHNIQUES[technique]
+    return t.fetch_bound(resolve_params(t, params))
+
+
+def test_every_ray_search_declares_its_coverage():
     for name in RAY_SEARCH:
         t = TECHNIQUES[name]
         assert t.fetch_bound is not None and t.fetch_bound(t.defaults()) >= 1, name
+        assert t.cost_view_scale is not None and t.layers_view_range is not None, name
+        assert t.contract_params or t.contract_exemption, f"{name}: contract_params, or a contract_exemption"
+        assert t.accuracy_settings, f"{name}: accuracy_settings (`wgpuviewer accuracy` measures them)"
+        for params in (*t.contract_params, *t.accuracy_settings):
+            resolve_params(t, params)  # known parameters, in range
+        for params in t.contract_params:  # each one differs from the defaults the tests run anyway
+            assert resolve_params(t, params) != t.defaults(), (name, params)
 
 
-@pytest.mark.parametrize("technique", RAY_SEARCH)
+@pytest.mark.parametrize(("technique", "params"), settings(RAY_SEARCH))
 @pytest.mark.parametrize("angle", [85.0, 89.0, 89.9])
-def test_grazing_views_are_finite_and_bounded(gpu, technique, angle):
-    bound = TECHNIQUES[technique].fetch_bound(TECHNIQUES[technique].defaults())
+def test_grazing_views_are_finite_and_bounded(gpu, technique, params, angle):
+    most = bound(technique, params)
     uv, view = random_rays(256, angle, seed=int(angle * 10))
     for name in MAPS:
-        got = probe(technique, height_map(name), uv, view, 0.05)
+        got = probe(technique, height_map(name), uv, view, 0.05, **params)
         assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all(), name
         assert ((got.depth >= 0) & (got.depth <= 1)).all(), name
-        assert got.fetches.max() <= bound, (name, int(got.fetches.max()), bound)
+        assert got.fetches.max() <= most, (name, int(got.fetches.max()), most)
 
 
-@pytest.mark.parametrize("technique", RAY_SEARCH)
-def test_horizontal_and_back_facing_views_are_finite_and_flagged(gpu, technique):
+@pytest.mark.parametrize(("technique", "params"), settings(RAY_SEARCH))
+def test_horizontal_and_back_facing_views_are_finite_and_flagged(gpu, technique, params):
     views = np.array([[1.0, 0.0, 0.0], [0.6, 0.8, 0.0], [0.0, 0.6, -0.8], [0.0, 0.0, -1.0], [1.0, 0.0, 1e-7]])
     uv = np.full((len(views), 2), 0.3)
     for name in ("bumps", "checker", "flat1"):
-        got = probe(technique, height_map(name), uv, views, 0.05)
+        got = probe(technique, height_map(name), uv, views, 0.05, **params)
         assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all(), name
         assert got.capped.all(), (name, got.capped)
     assert not exact_hit(1.0 - height_map("bumps"), uv, views, 0.05).valid.any()  # the reference declines them
 
 
-@pytest.mark.parametrize("technique", RAY_SEARCH)
-def test_fetches_within_the_declared_bound(gpu, technique):
-    t = TECHNIQUES[technique]
-    bound = t.fetch_bound(t.defaults())
+@pytest.mark.parametrize(("technique", "params"), settings(RAY_SEARCH))
+def test_fetches_within_the_declared_bound(gpu, technique, params):
+    most = bound(technique, params)
     for angle in (0.0, 45.0, 80.0):
         uv, view = random_rays(512, angle, seed=7)
         for name in ("bricks", "checker", "spike"):
-            got = probe(technique, height_map(name), uv, view, 0.05)
-            assert got.fetches.max() <= bound, (name, angle, int(got.fetches.max()))
+            got = probe(technique, height_map(name), uv, view, 0.05, **params)
+            assert got.fetches.max() <= most, (name, angle, int(got.fetches.max()))
             # fetches are counted: a ray that fetched nothing did not move (auto's basic candidate)
             idle = got.fetches == 0
             assert np.allclose(got.uv[idle], uv[idle], atol=1e-6), (name, angle)
 
 
-@pytest.mark.parametrize("technique", EXACT)
+@pytest.mark.parametrize(("technique", "params"), settings(EXACT))
 @pytest.mark.parametrize("name", MAPS)
-def test_exact_tracers_never_pass_the_first_hit(gpu, technique, name):
+def test_exact_tracers_never_pass_the_first_hit(gpu, technique, params, name):
     h = height_map(name)
     for angle in (0.0, 30.0, 60.0, 80.0, 85.0, 89.0):
         uv, view = random_rays(512, angle, seed=int(angle))
-        got = probe(technique, h, uv, view, 0.05)
+        got = probe(technique, h, uv, view, 0.05, **params)
         ref = exact_hit(1.0 - h, uv, view, 0.05)
         ok = ref.valid
         assert (got.depth[ok] <= ref.t[ok] + T_TOL).all(), (angle, float(np.max(got.depth[ok] - ref.t[ok])))
@@ -102,7 +121,7 @@ def axis_aligned_rays(n: int, angle: float, azimuth: float) -> tuple[np.ndarray,
 EXACT_TEXELS = 0.01
 
 
-@pytest.mark.parametrize("technique", EXACT)
+@pytest.mark.parametrize("technique", EXACT)  # at the defaults: the walk must finish to find the hit
 @pytest.mark.parametrize("name", ("wall", "step", "spike", "checker"))
 def test_exact_tracers_on_axis_aligned_rays(gpu, technique, name):
     h = height_map(name)

@@ -1,5 +1,5 @@
-"""The ray-search techniques of issue #4 (pom_adaptive, relief, maxmip, distance, distance_refined): what each
-one promises, measured with the GPU probe against the float64 reference."""
+"""The ray-search techniques pom_adaptive, relief, maxmip, distance and distance_refined, and the registry's view
+scales and layer-search ranges: what each one promises, measured with the GPU probe against the float64 reference."""
 
 from __future__ import annotations
 
@@ -257,6 +257,42 @@ def test_cost_scale_bounds_each_search():
     assert TECHNIQUES["maxmip"].cost_scale(TECHNIQUES["maxmip"].defaults()) == COMMON_COST_SCALE
 
 
+def _cost_scale_by_parameter_names(params: dict) -> float:
+    """The cost view's scale as it was once inferred from parameter names (frozen: the entries keep its values)."""
+    from wgpuviewer.relief.techniques import COMMON_COST_SCALE
+
+    if "layers" in params:
+        return float(params["layers"] + 1)
+    if "max_layers" in params:
+        return float(params["max_layers"] + 1)
+    if "linear_steps" in params:
+        return float(params["linear_steps"] + 1 + params.get("binary_steps", 0))
+    return COMMON_COST_SCALE
+
+
+def _layer_range_by_parameter_names(params: dict) -> tuple[float, float]:
+    """The layers view's range as it was once inferred from parameter names (frozen, as above)."""
+    from wgpuviewer.relief.techniques import AUTO_CANDIDATES
+
+    if "max_error" in params:
+        return 1.0, float(len(AUTO_CANDIDATES))
+    if params.get("max_layers", 0) > 0:
+        return float(params.get("min_layers", 0)), float(params["max_layers"])
+    return 0.0, float(max(params.get("layers", 0), params.get("linear_steps", 0), 1))
+
+
+def test_cost_and_layer_views_keep_their_scales():
+    """Each entry's own cost_scale and layer_range give what the parameter names once gave, for its defaults,
+    contract parameters and accuracy settings."""
+    from wgpuviewer.relief.techniques import resolve_params
+
+    for t in TECHNIQUES.values():
+        for overrides in ({}, *t.contract_params, *t.accuracy_settings):
+            params = resolve_params(t, overrides)
+            assert t.cost_scale(params) == _cost_scale_by_parameter_names(params), (t.name, overrides)
+            assert t.layer_range(params) == _layer_range_by_parameter_names(params), (t.name, overrides)
+
+
 # --- layer searches march the depth map's range --------------------------------------------------------------
 
 def test_depth_range_is_the_uploaded_maps_range_widened():
@@ -330,3 +366,19 @@ def test_the_renderer_marches_the_materials_range(gpu, tmp_path):
     assert np.allclose((lo, hi), depth_range(1.0 - height, gpu.depth_format), atol=1e-4)  # (16-bit PNG)
     k = (depth - lo) / ((hi - lo) / 8)
     assert depth.size > 500 and np.abs(k - np.round(k)).max() < 1e-3 and k.min() > -1e-3
+
+
+def test_markdown_table_has_a_row_per_technique():
+    """The README's technique table, generated from the registry: one row per entry, in registry order."""
+    from wgpuviewer.relief.techniques import markdown_table
+
+    header, rule, *rows = markdown_table().split("\n")
+    assert header == "| key | name | needs | what it costs (fetches per ray) | parameters |" and rule == "|---|---|---|---|---|"
+    assert len(rows) == len(TECHNIQUES)
+    for row, t in zip(rows, TECHNIQUES.values(), strict=True):
+        key, name, needs, cost, params = (cell.strip() for cell in row.strip("|").split(" | "))
+        assert key == t.key and name.startswith(f"`{t.name}`") and ("(exact)" in name) == t.exact
+        assert needs == ", ".join(t.textures) and cost == t.cost
+        assert [c.split("`")[1] for c in params.split(", ")] == [p.name for p in t.params] if t.params else params == "—"
+    assert "`layers` 16 (1 to 1024)" in rows[list(TECHNIQUES).index("pom")]
+    assert "`offset_limiting` (off)" in rows[list(TECHNIQUES).index("parallax")]

@@ -97,6 +97,19 @@ class Technique(Parametrized):
     fetch_bound: Callable[[dict], int] | None = None
     #: Finds the first hit of the bilinear surface to float32 precision: never behind the float64 exact hit.
     exact: bool = False
+    #: Ray searches: the fetch count the cost view draws as full heat, given the parameters (the search's own bound
+    #: where its parameters give one, else ``common_cost_scale``, so techniques compare side by side).
+    cost_view_scale: Callable[[dict], float] | None = None
+    #: Ray searches: (lo, hi) of the layers view's grey (N - lo) / (hi - lo), given the parameters, for the
+    #: ``layers`` count the trace reports (``no_layers`` for searches that report none).
+    layers_view_range: Callable[[dict], tuple[float, float]] | None = None
+    #: Ray searches: parameter overrides beyond the defaults that the contract tests (tests/relief/test_contracts.py)
+    #: run too: each setting that takes another code path (a flag, a variant, a smallest count or cap).
+    contract_params: tuple[dict, ...] = ()
+    #: Why ``contract_params`` is empty, where it is (the defaults already take every code path).
+    contract_exemption: str = ""
+    #: Ray searches: the parameter overrides ``wgpuviewer accuracy`` measures (``{}``: the defaults).
+    accuracy_settings: tuple[dict, ...] = ()
 
     @property
     def wgsl_file(self) -> str:
@@ -114,15 +127,24 @@ class Technique(Parametrized):
         return "depth" in self.textures
 
     def cost_scale(self, params: dict) -> float:
-        """Fetch count drawn as full heat in the cost view: the search's own bound where its parameters
-        give one (layer and linear searches), else a common scale so techniques compare side by side."""
-        if "layers" in params:
-            return float(params["layers"] + 1)
-        if "max_layers" in params:
-            return float(params["max_layers"] + 1)
-        if "linear_steps" in params:
-            return float(params["linear_steps"] + 1 + params.get("binary_steps", 0))
-        return COMMON_COST_SCALE
+        """Fetch count drawn as full heat in the cost view (``cost_view_scale``; the common scale for techniques
+        that are not ray searches)."""
+        return self.cost_view_scale(params) if self.cost_view_scale else COMMON_COST_SCALE
+
+    def layer_range(self, params: dict) -> tuple[float, float]:
+        """(lo, hi) of the layers view's grey (render.wgsl's layer_grey gets them in Frame): ``layers_view_range``,
+        or (0, 1) for techniques that are not ray searches (they report no layers)."""
+        return self.layers_view_range(params) if self.layers_view_range else no_layers(params)
+
+
+def common_cost_scale(params: dict) -> float:
+    """The cost view's scale for searches without a layer bound: one for all, so they compare side by side."""
+    return COMMON_COST_SCALE
+
+
+def no_layers(params: dict) -> tuple[float, float]:
+    """The layers view's range for searches that report no layer count (their ``layers`` is 0)."""
+    return 0.0, 1.0
 
 
 #: The refined distance map's direction bins (maps.py builds it with these maptools distance_refined options; the
@@ -158,12 +180,15 @@ AUTO_BUDGET_LOG2_MIN = -4
 AUTO_BUDGET_LEVELS = 8
 
 
-def _layer_search(name: str, key: str, description: str) -> Technique:
-    """steep and pom: the same layer march with the same parameter and bound (their WGSL differs in the finish)."""
+def _layer_search(name: str, key: str, description: str, accuracy_settings: tuple[dict, ...]) -> Technique:
+    """steep and pom: the same layer march with the same parameter, bound and coverage (their WGSL differs in the
+    finish)."""
     return Technique(
         name, key, description, "up to N+1 depth fetches", ("albedo", "normal", "depth"),
         (Param("layers", 16, 1, MAX_LAYERS, int, "layer count: the ray is tested at this many evenly spaced depths"),),
-        ray_search=True, fetch_bound=lambda p: p["layers"] + 1,
+        ray_search=True, fetch_bound=lambda p: p["layers"] + 1, cost_view_scale=lambda p: p["layers"] + 1.0,
+        layers_view_range=lambda p: (0.0, float(p["layers"])), contract_params=({"layers": 1},),
+        accuracy_settings=accuracy_settings,
     )
 
 
@@ -193,17 +218,20 @@ TECHNIQUES: dict[str, Technique] = {
             "the division by V.z is dropped (Welsh), which bounds the offset at grazing angles.",
             "1 depth fetch", ("albedo", "normal", "depth"),
             (Param("offset_limiting", False, 0, 1, bool, "drop the 1/V.z factor (bounded offset)"),),
-            ray_search=True, fetch_bound=lambda p: 1,
+            ray_search=True, fetch_bound=lambda p: 1, cost_view_scale=common_cost_scale, layers_view_range=no_layers,
+            contract_params=({"offset_limiting": True},), accuracy_settings=({}, {"offset_limiting": True}),
         ),
         _layer_search(
             "steep", "4",
             "Steep parallax mapping: march N depth layers along the view ray, stop at the first layer "
             "below the surface.",
+            ({"layers": 32},),
         ),
         _layer_search(
             "pom", "5",
             "Parallax occlusion mapping: steep parallax, then linear interpolation between the last two "
             "layers (guarded against a zero denominator).",
+            ({"layers": 8}, {"layers": 32}, {"layers": 256}),
         ),
         Technique(
             "pom_adaptive", "6",
@@ -217,6 +245,10 @@ TECHNIQUES: dict[str, Technique] = {
                 Param("angle_only", False, 0, 1, bool, "ignore the complexity map (three.js/Godot variant)"),
             ),
             ray_search=True, fetch_bound=lambda p: max(p["min_layers"], p["max_layers"]) + 1,
+            cost_view_scale=lambda p: p["max_layers"] + 1.0,
+            layers_view_range=lambda p: (float(p["min_layers"]), float(p["max_layers"])),
+            contract_params=({"angle_only": True}, {"min_layers": 8, "max_layers": 2}),
+            accuracy_settings=({}, {"angle_only": True}),
         ),
         Technique(
             "relief", "7",
@@ -228,15 +260,22 @@ TECHNIQUES: dict[str, Technique] = {
                 Param("binary_steps", 6, 0, 32, int, "binary refinement steps (each halves the bracket)"),
             ),
             ray_search=True, fetch_bound=lambda p: p["linear_steps"] + 1 + p["binary_steps"],
+            cost_view_scale=lambda p: p["linear_steps"] + 1.0 + p["binary_steps"],
+            layers_view_range=lambda p: (0.0, float(p["linear_steps"])),
+            contract_params=({"linear_steps": 1, "binary_steps": 0},),
+            accuracy_settings=({}, {"linear_steps": 32, "binary_steps": 8}),
         ),
         Technique(
             "maxmip", "8",
-            "Maximum-mipmap tracing (seed 004): descend a max pyramid over the bilinear cells from the top, skip "
-            "nodes the ray passes above, climb back after a skip; solve the exact per-cell quadratic at the base. "
-            "Finds the first hit of the bilinear surface to float32 precision (repeat addressing).",
+            "Maximum-mipmap tracing (Romanyuk & Dudnyk 2018, modified MIP pyramid): descend a max pyramid over the "
+            "bilinear cells from the top, skip nodes the ray passes above, climb back after a skip; solve the exact "
+            "per-cell quadratic at the base. Finds the first hit of the bilinear surface to float32 precision (repeat "
+            "addressing).",
             "pyramid texel per node + one 2x2 gather per base cell", ("albedo", "normal", "depth", "maxmip"),
             (Param("max_steps", 1024, 1, 65536, int, "cap on traversal steps (capped rays are flagged)"),),
             ray_search=True, fetch_bound=lambda p: p["max_steps"], exact=True,
+            cost_view_scale=common_cost_scale, layers_view_range=no_layers,
+            contract_params=({"max_steps": 8},), accuracy_settings=({},),
         ),
         Technique(
             "distance", "9",
@@ -246,10 +285,12 @@ TECHNIQUES: dict[str, Technique] = {
             "one volume fetch per step + one 2x2 gather per exact cell", ("albedo", "normal", "depth", "distance"),
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
             ray_search=True, fixed=distance_fixed(1, 1, None), fetch_bound=lambda p: 2 * p["iterations"], exact=True,
+            cost_view_scale=common_cost_scale, layers_view_range=no_layers,
+            contract_params=({"iterations": 8},), accuracy_settings=({},),
         ),
         Technique(
             "distance_refined", "0",
-            "Distance-map parallax on the direction-binned refined map (seed 000): the same tracer as distance "
+            "Distance-map parallax on the direction-binned refined map (Romanyuk et al. 2017): the same tracer as distance "
             f"(distance.wgsl); the map has one volume per bin of ray directions ({REFINED_SECTORS} azimuth sectors x "
             f"{REFINED_BANDS} polar bands within {REFINED_MAX_ANGLE:g} degrees) with longer safe steps for "
             "the rays of that bin, and the plain volume for steeper rays. A ray picks its volume once.",
@@ -258,6 +299,8 @@ TECHNIQUES: dict[str, Technique] = {
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
             ray_search=True, wgsl="distance.wgsl", fetch_bound=lambda p: 2 * p["iterations"], exact=True,
             fixed=distance_fixed(REFINED_SECTORS, REFINED_BANDS, REFINED_MAX_ANGLE),
+            cost_view_scale=common_cost_scale, layers_view_range=no_layers,
+            contract_params=({"iterations": 8},), accuracy_settings=({},),
         ),
         Technique(
             "quadmax", "-",
@@ -273,6 +316,8 @@ TECHNIQUES: dict[str, Technique] = {
                 Param("max_steps", QUADMAX_STEPS, 1, 65536, int, "cap on traversal steps (capped rays are flagged)"),
             ),
             ray_search=True, fetch_bound=lambda p: 2 * p["max_steps"],
+            cost_view_scale=common_cost_scale, layers_view_range=no_layers,
+            contract_params=({"top_offset": 3, "max_steps": 8}, {"top_offset": -8}), accuracy_settings=({},),
         ),
         Technique(
             "quadmax_pom", "-",
@@ -288,6 +333,8 @@ TECHNIQUES: dict[str, Technique] = {
             ),
             ray_search=True, fixed=(("top_offset", float(QUADMAX_TOP_OFFSET)),),
             fetch_bound=lambda p: 2 * p["skip_steps"] + p["layers"] + 1,
+            cost_view_scale=lambda p: p["layers"] + 1.0, layers_view_range=lambda p: (0.0, float(p["layers"])),
+            contract_params=({"skip_steps": 1, "layers": 1},), accuracy_settings=({}, {"skip_steps": 16}),
         ),
         Technique(
             "auto", "-",
@@ -304,6 +351,12 @@ TECHNIQUES: dict[str, Technique] = {
                    ("budget_log2_min", float(AUTO_BUDGET_LOG2_MIN)), ("quadmax_steps", float(QUADMAX_STEPS))),
             fetch_bound=lambda p: max(TECHNIQUES[name].fetch_bound(resolve_params(TECHNIQUES[name], params))
                                       for name, params in AUTO_CANDIDATES if TECHNIQUES[name].ray_search),
+            cost_view_scale=common_cost_scale,
+            # the layers view shows the chosen candidate (1-based, cheapest first) instead of a layer count
+            layers_view_range=lambda p: (1.0, float(len(AUTO_CANDIDATES))),
+            contract_params=({"max_error": 2.0 ** AUTO_BUDGET_LOG2_MIN},
+                             {"max_error": 2.0 ** (AUTO_BUDGET_LOG2_MIN + AUTO_BUDGET_LEVELS - 1)}),
+            accuracy_settings=({"max_error": 0.25}, {"max_error": 0.5}, {"max_error": 1.0}),
         ),
         Technique(
             "cone", "-",
@@ -321,6 +374,8 @@ TECHNIQUES: dict[str, Technique] = {
             fixed=(("max_ratio", CONE_MAX_RATIO), ("halvings_max", float(CONE_HALVINGS_MAX)),
                    ("finish_cells", float(CONE_FINISH_CELLS))),
             fetch_bound=lambda p: 2 * p["iterations"] + CONE_HALVINGS_MAX + CONE_FINISH_CELLS,
+            cost_view_scale=common_cost_scale, layers_view_range=no_layers,
+            contract_params=({"iterations": 8},), accuracy_settings=({},),
         ),
     )
 }
@@ -346,3 +401,19 @@ def resolve_params(technique: Technique, overrides: dict | None = None, where: s
             raise UserError(f"{key}: unknown parameter of {kind} {technique.name!r}; known: {known}") from None
         values[name] = param.validate(value, key)
     return values
+
+
+def _param_cell(p: Param) -> str:
+    if p.kind is bool:
+        return f"`{p.name}` ({'on' if p.default else 'off'})"
+    return f"`{p.name}` {p.default:g} ({p.min:g} to {p.max:g})"
+
+
+def markdown_table() -> str:
+    """The README's technique table: key, name, the maps it samples, what it costs, its parameters (default, range)."""
+    rows = ["| key | name | needs | what it costs (fetches per ray) | parameters |", "|---|---|---|---|---|"]
+    for t in TECHNIQUES.values():
+        name = f"`{t.name}`" + (" (exact)" if t.exact else "")
+        params = ", ".join(_param_cell(p) for p in t.params) or "—"
+        rows.append(f"| {t.key} | {name} | {', '.join(t.textures)} | {t.cost} | {params} |")
+    return "\n".join(rows)
