@@ -1,4 +1,4 @@
-// Maximum-mipmap tracing (seed 004), exact on the bilinear surface.
+// Maximum-mipmap tracing (Romanyuk & Dudnyk 2018, modified MIP pyramid), exact on the bilinear surface.
 //
 // The surface between four texel centres (a "cell", texel coordinates x = u * W - 0.5) is a bilinear
 // patch, never higher than its highest corner. maps.py builds level 0 of the pyramid as that corner

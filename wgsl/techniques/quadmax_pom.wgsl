@@ -1,4 +1,4 @@
-// quadmax_pom: a bounded conservative skip, then a short POM search (the quadtree-displacement idea; issue 13's
+// quadmax_pom: a bounded conservative skip, then a short POM search (the quadtree-displacement idea as a
 // hybrid). The skip is quadmax's walk (common/quadmax.wgsl) cut after skip_steps steps: if it meets the surface
 // within them its hit is quadmax's (exact on the packed leaves); otherwise it stops at a point t_s it proved free
 // (everything before it is free too) and POM marches `layers` equal layers of [t_s, depth_max] from there, then
