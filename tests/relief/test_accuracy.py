@@ -1,4 +1,4 @@
-"""The cost measures of relief/accuracy.py."""
+"""The cost measures of relief/accuracy.py and the writer of docs/accuracy.md."""
 
 from __future__ import annotations
 
@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from wgpuviewer.core.errors import InputError
-from wgpuviewer.relief.accuracy import simd_tile_cost
+from wgpuviewer.relief.accuracy import markdown_report, measure, run, simd_tile_cost
+from wgpuviewer.textures import builtin_height
 
 
 def test_simd_tile_cost_is_the_mean_of_tile_maxima():
@@ -28,3 +29,35 @@ def test_simd_tile_cost_partial_tiles_and_coverage():
     assert np.isnan(simd_tile_cost(f, covered=np.zeros_like(covered)))
     with pytest.raises(InputError):
         simd_tile_cost(np.zeros(5))
+
+
+def test_markdown_report_of_a_tiny_run(gpu):
+    """docs/accuracy.md's writer: the command, adapter and date at the top, one table per height map with a row per
+    setting and a column per angle; each cell is the measurement ``measure`` gives (the run traces the reference
+    once per map and angle for all settings)."""
+    maps = {"step": builtin_height("step", (16, 16)), "flat1": builtin_height("flat1", (16, 8))}
+    settings = (("pom", {"layers": 4}), ("maxmip", {"max_steps": 1}))
+    measured = run(maps, angles=(0.0, 60.0), settings=settings, rays=32)
+    text = markdown_report(measured, command="wgpuviewer accuracy --doc x.md", adapter="Test GPU", date="2026-01-02")
+    lines = text.splitlines()
+    assert lines[0].startswith("# ") and "`wgpuviewer accuracy --doc x.md`" in lines[2]
+    assert lines[4].startswith("Adapter: Test GPU; 2026-01-02;") and "32 random rays" in lines[4]
+    headings = [i for i, line in enumerate(lines) if line.startswith("## ")]
+    assert [lines[i] for i in headings] == ["## step (16x16)", "## flat1 (16x8)"]
+    for i, (name, height) in zip(headings, maps.items(), strict=True):
+        assert lines[i + 2] == "| technique | params | 0° | 60° |"
+        rows = lines[i + 4:i + 6]
+        for row, (technique, params) in zip(rows, settings, strict=True):
+            cells = [c.strip() for c in row.strip("|").split("|")]
+            assert cells[:2] == [technique, ", ".join(f"{k}={v}" for k, v in params.items())]
+            for cell, angle in zip(cells[2:], (0.0, 60.0), strict=True):
+                a = measure(technique, height, angle, rays=32, **params)
+                p95, rest = cell.split(" / ")
+                if np.isnan(a.error_p95):  # every ray capped
+                    assert p95 == "–", (name, technique, angle)
+                else:
+                    assert float(p95) == pytest.approx(a.error_p95, abs=1e-3), (name, technique, angle)
+                assert f"· {a.fetches_mean:.1f}" in rest and ("capped" in rest) == (a.capped > 0)
+    # a map whose every ray is capped shows no error, and says so
+    capped = measured.results["step", 1, 60.0]
+    assert capped.capped == 1.0 and lines[headings[0] + 5].endswith("– / – · 1.0 · 100.0% capped |")

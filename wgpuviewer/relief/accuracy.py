@@ -1,12 +1,14 @@
 """Probe-against-reference measurements: UV error in texels, fetches per ray, capped fraction, and the
 divergence-aware SIMD-tile cost.
 
-Used by the tests, ``wgpuviewer accuracy`` and the benchmark, so every number about a technique's error and cost
-is computed one way.
+Used by the tests, ``wgpuviewer accuracy`` (its table, and docs/accuracy.md: ``run`` then ``markdown_report``) and
+the benchmark, so every number about a technique's error and cost is computed one way.
 """
 
 from __future__ import annotations
 
+import datetime
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,7 +16,8 @@ import numpy as np
 from wgpuviewer.core.errors import InputError
 
 from .probe import probe
-from .reference import exact_hit, uv_error_texels, view_dir_from_angles
+from .reference import Hit, exact_hit, uv_error_texels, view_dir_from_angles
+from .techniques import TECHNIQUES
 
 
 @dataclass
@@ -75,8 +78,14 @@ def measure(
     """Trace ``rays`` random rays at ``angle_deg`` with the GPU probe and the float64 reference."""
     height = np.asarray(height, np.float64)
     uv, view = random_rays(rays, angle_deg, seed)
-    got = probe(technique, height, uv, view, height_scale, backend=backend, **params)
     ref = exact_hit(1.0 - height, uv, view, height_scale)
+    return _scored(technique, params, height, angle_deg, uv, view, ref, height_scale, backend)
+
+
+def _scored(technique: str, params: dict, height: np.ndarray, angle_deg: float, uv, view, ref: Hit,
+            height_scale: float, backend) -> Accuracy:
+    """The probe's hits for rays (uv, view) against their reference hits ``ref``."""
+    got = probe(technique, height, uv, view, height_scale, backend=backend, **params)
     ok = ~got.capped & ref.valid
     err = uv_error_texels(got.uv[ok], ref.uv[ok], height.shape[::-1]) if ok.any() else np.array([np.nan])
     fetches = got.fetches.astype(np.float64)
@@ -84,17 +93,14 @@ def measure(
         technique=technique, angle=angle_deg, params=params,
         error_mean=float(np.mean(err)), error_p95=float(np.percentile(err, 95)), error_max=float(np.max(err)),
         fetches_mean=float(fetches.mean()), fetches_p95=float(np.percentile(fetches, 95)),
-        capped=float(got.capped.mean()), rays=rays,
+        capped=float(got.capped.mean()), rays=len(uv),
     )
 
 
 DEFAULT_ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 89.0, 89.9)
-DEFAULT_SETTINGS = (
-    ("parallax", {}), ("parallax", {"offset_limiting": True}),
-    ("steep", {"layers": 32}), ("pom", {"layers": 8}), ("pom", {"layers": 32}), ("pom", {"layers": 256}),
-    ("pom_adaptive", {}), ("pom_adaptive", {"angle_only": True}),
-    ("relief", {}), ("relief", {"linear_steps": 32, "binary_steps": 8}),
-    ("maxmip", {}), ("distance", {}), ("distance_refined", {}), ("cone", {}),
+#: (technique, parameter overrides) ``wgpuviewer accuracy`` measures: each ray-search entry's accuracy_settings.
+DEFAULT_SETTINGS: tuple[tuple[str, dict], ...] = tuple(
+    (name, params) for name, t in TECHNIQUES.items() if t.ray_search for params in t.accuracy_settings
 )
 
 
@@ -104,22 +110,103 @@ def npot_height(shape=(401, 343)) -> np.ndarray:
     return np.clip(0.5 + 0.2 * np.sin(np.arange(rows)[:, None] / 9.0) * np.cos(np.arange(cols)[None, :] / 7.0), 0, 1)
 
 
+@dataclass
+class Run:
+    """One accuracy run: every setting at every angle on every height map, the same random rays (seed 0) for every
+    setting of a (map, angle), each traced once by the float64 reference."""
+    heightmaps: dict[str, tuple[int, int]]  # name -> (rows, cols)
+    angles: tuple[float, ...]
+    settings: tuple[tuple[str, dict], ...]
+    height_scale: float
+    rays: int
+    seconds: float
+    #: (height map, index in settings, angle) -> the measurement
+    results: dict[tuple[str, int, float], Accuracy]
+
+
+def run(heightmaps: dict, angles=DEFAULT_ANGLES, settings=DEFAULT_SETTINGS, height_scale=0.05, rays=4096,
+        backend=None, progress=None) -> Run:
+    """Measure each setting at each angle on each height map (``progress()`` after each measurement)."""
+    start = time.perf_counter()
+    results = {}
+    for name, height in heightmaps.items():
+        height = np.asarray(height, np.float64)
+        for angle in angles:
+            uv, view = random_rays(rays, angle)
+            ref = exact_hit(1.0 - height, uv, view, height_scale)
+            for i, (technique, params) in enumerate(settings):
+                results[name, i, angle] = _scored(technique, params, height, angle, uv, view, ref, height_scale,
+                                                  backend)
+                if progress:
+                    progress()
+    return Run({name: np.shape(h) for name, h in heightmaps.items()}, tuple(angles), tuple(settings),
+               height_scale, rays, time.perf_counter() - start, results)
+
+
+def _label(params: dict) -> str:
+    return ", ".join(f"{k}={v}" for k, v in params.items()) or "-"
+
+
 def table(heightmaps: dict, angles=DEFAULT_ANGLES, settings=DEFAULT_SETTINGS, height_scale=0.05, rays=4096,
           backend=None, progress=None) -> str:
-    """Markdown table of probe-vs-reference accuracy for each height map x setting x angle."""
+    """Markdown table of probe-vs-reference accuracy, one row per height map x setting x angle."""
+    measured = run(heightmaps, angles, settings, height_scale, rays, backend, progress)
     lines = [
         "| height map | technique | params | angle | UV err mean | p95 | max (texels) | fetches mean | p95 | capped |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for name, height in heightmaps.items():
-        for technique, params in settings:
-            for angle in angles:
-                a = measure(technique, height, angle, height_scale, rays, backend=backend, **params)
-                label = ", ".join(f"{k}={v}" for k, v in params.items()) or "-"
+    for name in measured.heightmaps:
+        for i, (technique, params) in enumerate(measured.settings):
+            for angle in measured.angles:
+                a = measured.results[name, i, angle]
                 lines.append(
-                    f"| {name} | {technique} | {label} | {angle:g}° | {a.error_mean:.3f} | {a.error_p95:.3f} | "
+                    f"| {name} | {technique} | {_label(params)} | {angle:g}° | {a.error_mean:.3f} | {a.error_p95:.3f} | "
                     f"{a.error_max:.2f} | {a.fetches_mean:.1f} | {a.fetches_p95:.0f} | {a.capped:.1%} |"
                 )
-                if progress:
-                    progress()
     return "\n".join(lines)
+
+
+def _texels(x: float) -> str:
+    if not np.isfinite(x):
+        return "–"  # every ray capped or declined by the reference
+    return f"{x:.3f}" if x < 10 else f"{x:.1f}"
+
+
+def _cell(a: Accuracy) -> str:
+    """p95 / max UV error · mean fetches, and the capped share where rays were capped."""
+    text = f"{_texels(a.error_p95)} / {_texels(a.error_max)} · {a.fetches_mean:.1f}"
+    if a.capped > 0:
+        text += f" · {a.capped:.1%} capped" if a.capped >= 0.001 else " · <0.1% capped"
+    return text
+
+
+def markdown_report(measured: Run, command: str, adapter: str, date: str | None = None) -> str:
+    """docs/accuracy.md: the command and adapter first, what the numbers are, then one table per height map (a
+    row per setting, a column per angle). ``date``: YYYY-MM-DD (default: today, UTC)."""
+    date = date or datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d")
+    sizes = sorted({f"{cols}x{rows}" for rows, cols in measured.heightmaps.values()})
+    lines = [
+        "# Probe accuracy: every ray-search technique against the float64 exact hit",
+        "",
+        f"Generated by `{command}` (this whole file, from one run).",
+        "",
+        f"Adapter: {adapter}; {date}; {measured.seconds / 60:.1f} minutes. height_scale {measured.height_scale:g}; "
+        f"{', '.join(sizes)} maps; {measured.rays} random rays per map and angle (uniform entry points, random "
+        "azimuth, seed 0), the same rays for every technique.",
+        "",
+        "Each cell is **p95 / max UV error** in texels (wrap-aware) between the technique's hit, traced on the GPU by "
+        "the probe (the renderer's own `trace`), and the float64 first hit of the bilinear surface "
+        "(`relief.reference.exact_hit`), then **· mean fetches** per ray as the technique counts them (depth "
+        "samples; for the map-based tracers their map's texels and 2x2 gathers, see the technique table in the "
+        "README). Rays flagged *capped* (a view with V.z < 1e-4, a step cap reached) are excluded from the errors; "
+        "their share follows where there are any. The settings are each technique's `accuracy_settings` in "
+        "`relief/techniques.py` (params: the overrides of its defaults, `-` for none).",
+    ]
+    header = "| technique | params | " + " | ".join(f"{angle:g}°" for angle in measured.angles) + " |"
+    rule = "|---|---|" + "---|" * len(measured.angles)
+    for name, (rows, cols) in measured.heightmaps.items():
+        lines += ["", f"## {name} ({cols}x{rows})", "", header, rule]
+        for i, (technique, params) in enumerate(measured.settings):
+            cells = " | ".join(_cell(measured.results[name, i, angle]) for angle in measured.angles)
+            lines.append(f"| {technique} | {_label(params)} | {cells} |")
+    return "\n".join(lines) + "\n"
