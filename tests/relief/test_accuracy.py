@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from wgpuviewer.core.errors import InputError
-from wgpuviewer.relief.accuracy import markdown_report, measure, run, simd_tile_cost
+from wgpuviewer.relief.accuracy import DEFAULT_SETTINGS, markdown_report, measure, run, simd_tile_cost
+from wgpuviewer.relief.techniques import TECHNIQUES
 from wgpuviewer.textures import builtin_height
 
 
@@ -61,3 +62,11 @@ def test_markdown_report_of_a_tiny_run(gpu):
     # a map whose every ray is capped shows no error, and says so
     capped = measured.results["step", 1, 60.0]
     assert capped.capped == 1.0 and lines[headings[0] + 5].endswith("– / – · 1.0 · 100.0% capped |")
+
+
+def test_accuracy_measures_every_ray_search_technique():
+    """``wgpuviewer accuracy``'s settings are the registry's: each ray-search entry's accuracy_settings, in order."""
+    expected = [(name, params) for name, t in TECHNIQUES.items() if t.ray_search for params in t.accuracy_settings]
+    assert list(DEFAULT_SETTINGS) == expected
+    assert {name for name, _ in DEFAULT_SETTINGS} == {name for name, t in TECHNIQUES.items() if t.ray_search}
+    assert {"quadmax", "quadmax_pom", "auto"} <= {name for name, _ in DEFAULT_SETTINGS}
