@@ -58,7 +58,7 @@ def room(name: str) -> str:
     parts = name.split(".")
     if parts[0] == "maptools":
         return "maptools"
-    if len(parts) >= 2 and parts[1] in ("core", "relief", "viewer", "bench"):
+    if len(parts) >= 2 and parts[1] in ("core", "relief", "viewer", "bench", "harness"):
         return parts[1]
     if len(parts) >= 3 and parts[1] == "studies":
         return f"studies.{parts[2]}"
@@ -71,7 +71,7 @@ def allowed(src: str, dst: str) -> bool:
         return True
     if a == "core":
         return False
-    if a == "maptools":
+    if a in ("maptools", "harness"):
         return b == "core"
     if src in SCENE_MODULES:
         return b == "core" or dst == "wgpuviewer.relief.techniques" or dst in SCENE_MODULES
@@ -81,9 +81,9 @@ def allowed(src: str, dst: str) -> bool:
     if a == "viewer":
         return base
     if a == "bench":
-        return base or b == "maptools"
+        return base or b in ("maptools", "harness")
     if a.startswith("studies."):  # a study may measure on the benchmark's views; never another study
-        return base or b in ("maptools", "bench")
+        return base or b in ("maptools", "bench", "harness")
     return True  # cli, __main__ and the documented re-exports
 
 

@@ -108,3 +108,40 @@ def test_view_without_display_renders_a_png(tmp_path, adapter):
     # no arguments at all = view the default scene
     result = run_cli(env=env, cwd=tmp_path)
     assert result.returncode == 0 and "no display" in result.stdout
+
+
+def test_every_study_folder_is_a_registered_subcommand():
+    """A folder under wgpuviewer/studies/ is a command without any list to edit: the harness finds it."""
+    from wgpuviewer import cli
+
+    folders = sorted(p.name for p in (ROOT / "wgpuviewer" / "studies").iterdir() if (p / "__init__.py").is_file())
+    assert folders  # filtering, perspective, refined_distance, ...
+    _, commands = cli.build_parser()
+    for folder in folders:
+        assert folder.replace("_", "-") in commands, folder
+    assert {"view", "render", "techniques", "filters", "accuracy", "bench", "info"} <= set(commands)
+
+
+def test_a_discovered_study_runs_with_the_shared_options_and_its_command_line(monkeypatch, capsys):
+    from wgpuviewer.harness import study as harness_study
+
+    seen = {}
+
+    class Probe:
+        name = "probe-study"
+        help = "records what it was given"
+
+        def add_arguments(self, parser):
+            harness_study.add_measurement_options(parser, "output folder", "smoke or full")
+            parser.add_argument("--angles")
+
+        def run(self, args):
+            seen.update(vars(args))
+            return 0
+
+    monkeypatch.setattr(harness_study, "discover", lambda: [Probe()])
+    assert main(["probe-study", "--out", "my runs", "--suite", "smoke", "--angles", "1,2"]) == 0
+    assert seen["command_line"] == "wgpuviewer probe-study --out 'my runs' --suite smoke --angles 1,2"
+    assert seen["suite"] == "smoke" and seen["out"] == "my runs" and seen["backend"] is None and not seen["quiet"]
+    assert main(["probe-study", "--suite", "smoke"]) == 2  # --out is required, as for every measuring command
+    assert "required: --out" in capsys.readouterr().err

@@ -1,4 +1,5 @@
-"""Command line: ``wgpuviewer view|render|techniques|filters|info|accuracy|bench|filtering``."""
+"""Command line: ``wgpuviewer view|render|techniques|filters|accuracy|info`` here, and the measuring commands:
+``bench`` and every study under ``wgpuviewer/studies/`` (found by the harness, each registering itself)."""
 
 from __future__ import annotations
 
@@ -8,23 +9,20 @@ import os
 import sys
 from pathlib import Path
 
-from wgpuviewer.core.cli import OneLineParser, prepare_process, run_command, terminal_progress
+from wgpuviewer.core.cli import (
+    OneLineParser,
+    add_backend_option,
+    parse_size,
+    prepare_process,
+    run_command,
+    terminal_progress,
+)
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.io import output_dir, refuse_directory
+from wgpuviewer.core.io import refuse_directory
 
 DEFAULT_SIZE = (1280, 720)
 MATERIAL_HELP = ("a material folder (ambientCG, Poly Haven or albedo/normal/height names) shown on the scene's "
                  "first plane; without SCENE, the default scene's")
-
-
-def parse_size(text: str) -> tuple[int, int]:
-    try:
-        w, h = (int(part) for part in text.lower().split("x"))
-    except ValueError:
-        raise UserError(f"--size {text!r}: expected WIDTHxHEIGHT, e.g. 1280x720") from None
-    if not (1 <= w <= 16384 and 1 <= h <= 16384):
-        raise UserError(f"--size {text!r}: width and height must be 1 to 16384")
-    return w, h
 
 
 def load_scene_arg(path: str | None):
@@ -159,35 +157,6 @@ def cmd_filters(args) -> int:
     return 0
 
 
-def _numbers(text, option, example):
-    items = names(text, option)
-    if items is None:
-        return None
-    try:
-        return [float(x) for x in items]
-    except ValueError:
-        raise UserError(f"{option} {text!r}: expected comma-separated numbers, e.g. {example}") from None
-
-
-def cmd_filtering(args) -> int:
-    from wgpuviewer.studies.filtering.run import run
-    from wgpuviewer.studies.filtering.suites import resolve_options
-
-    size = None
-    if args.size:
-        size = parse_size(args.size)
-    command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["filtering"] else "wgpuviewer filtering"
-    options = resolve_options(
-        args.suite, size=size, frames=args.frames, reliefs=names(args.reliefs, "--reliefs"),
-        albedos=names(args.albedos, "--albedos"), angles=_numbers(args.angles, "--angles", "0,45,80"),
-        footprints=_numbers(args.footprints, "--footprints", "1,4"), filters=names(args.filters, "--filters"),
-        backend=args.backend, command=command,
-    )
-    run(options, Path(args.out), progress=not args.quiet)
-    print(Path(args.out) / "report.md")
-    return 0
-
-
 def cmd_accuracy(args) -> int:
     if args.rays < 1:
         raise UserError(f"--rays {args.rays}: expected at least 1 ray")
@@ -217,81 +186,6 @@ def cmd_accuracy(args) -> int:
     return 0
 
 
-def names(text: str | None, option: str) -> list[str] | None:
-    """A comma-separated option value as a list (None when the option was not given)."""
-    if text is None:
-        return None
-    items = [x.strip() for x in text.split(",") if x.strip()]
-    if not items:
-        raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
-    return items
-
-
-def angle_list(text: str | None) -> list[float] | None:
-    """--angles as degrees (None when not given)."""
-    if text is None:
-        return None
-    try:
-        return [float(x) for x in names(text, "--angles")]
-    except ValueError:
-        raise UserError(f"--angles {text!r}: expected comma-separated degrees, e.g. 0,45,80") from None
-
-
-def cmd_bench(args) -> int:
-    from wgpuviewer.bench.run import resolve_options, run
-
-    angles = angle_list(args.angles)
-
-    def size(text, option):
-        if not text:
-            return None
-        try:
-            return parse_size(text)
-        except UserError as e:
-            raise UserError(str(e).replace("--size", option)) from None
-
-    command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["bench"] else "wgpuviewer bench"
-    options = resolve_options(args.suite, resolution=size(args.resolution, "--resolution"),
-                              heightmaps=names(args.heightmaps, "--heightmaps"),
-                              techniques=names(args.techniques, "--techniques"), angles=angles, frames=args.frames,
-                              backend=args.backend, command=command, simd_tile=size(args.simd_tile, "--simd-tile"))
-    out = output_dir(args.out, "--out")  # before a long run, not after it
-    if args.from_csv:
-        from wgpuviewer.bench.run import rereport
-
-        rereport([Path(p) for p in args.from_csv], out, command)
-        print(out / "report.md")
-        return 0
-    run(options, out, progress=not args.quiet)
-    for note in options.notes:
-        print(f"note: {note}", file=sys.stderr)
-    print(out / "report.md")
-    return 0
-
-
-def cmd_perspective(args) -> int:
-    from wgpuviewer.studies.perspective.run import run
-
-    command = "wgpuviewer " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["perspective"] else "wgpuviewer perspective"
-    out = Path(args.out)
-    run(args.suite, out, backend=args.backend, progress=not args.quiet, command=command)
-    print(out / "report.md")
-    return 0
-
-
-def cmd_refined_distance(args) -> int:
-    from wgpuviewer.studies.refined_distance.run import run
-
-    angles = angle_list(args.angles)
-    if angles is not None and not all(0.0 <= a <= 85.0 for a in angles):
-        raise UserError(f"--angles {args.angles!r}: expected degrees from 0 to 85")
-    heightmaps = names(args.heightmaps, "--heightmaps")
-    out = output_dir(args.out, "--out")
-    run(args.suite, out, heightmaps=heightmaps, angles=angles, backend=args.backend, progress=not args.quiet)
-    print(out / "report.md")
-    return 0
-
-
 def cmd_info(args) -> int:
     from wgpuviewer.core.gpu import describe_adapters
 
@@ -310,33 +204,28 @@ def add_filter_options(parser) -> None:
                         f"(default {DEFAULT_DERIVATIVES})")
 
 
-def measurement_parser(sub, name: str, help: str, out_help: str, suite_help: str, backend_help: str):
-    """A measuring command's parser (bench and the studies) with the options they share: --out, --suite, --backend,
-    --quiet; the caller adds its own."""
-    from wgpuviewer.core.gpu import BACKEND_CHOICES
+def measurement_commands() -> list:
+    """bench, then every study folder's ``STUDY`` (the harness finds them)."""
+    from wgpuviewer.bench import STUDY as BENCH
+    from wgpuviewer.harness.study import discover
 
-    parser = sub.add_parser(name, help=help)
-    parser.add_argument("--out", required=True, help=out_help)
-    parser.add_argument("--suite", choices=("smoke", "full"), default="full", help=suite_help)
-    parser.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    return parser
+    return [BENCH, *discover()]
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from wgpuviewer.core.gpu import BACKEND_CHOICES, BACKEND_ENV
+def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
+    """The parser and the names of its commands."""
+    from wgpuviewer.harness.study import register
     from wgpuviewer.relief.output import OUTPUT_MODES
 
     parser = OneLineParser(
         prog="wgpuviewer", description="Relief-mapping techniques on WebGPU: viewer, offscreen renderer, probe."
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    backend_help = f"wgpu backend (default: ${BACKEND_ENV} or auto: hardware first, then software)"
 
     view = sub.add_parser("view", help="open the interactive viewer (renders a PNG when there is no display)")
     view.add_argument("scene", nargs="?", help="scene TOML (default: the built-in default scene)")
     view.add_argument("--technique", help="technique to start with (default: the scene's)")
-    view.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    add_backend_option(view)
     view.add_argument("--frames", type=int, help="scripted run: draw this many frames, then exit")
     view.add_argument("--screenshot", help="scripted run: save the last frame to this PNG")
     view.add_argument("--keys", help="scripted run: comma-separated keys to press, one per frame (e.g. 2,3,ArrowRight)")
@@ -353,7 +242,7 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--technique", help="technique (default: the scene's)")
     render.add_argument("--size", help=f"WIDTHxHEIGHT (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
     render.add_argument("--mode", choices=OUTPUT_MODES, default="color", help="what to write")
-    render.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    add_backend_option(render)
     render.add_argument("--material", metavar="DIR", help=MATERIAL_HELP)
     add_filter_options(render)
     render.set_defaults(func=cmd_render)
@@ -369,70 +258,30 @@ def build_parser() -> argparse.ArgumentParser:
     accuracy.add_argument("--texels", type=int, default=256, help="map size (square)")
     accuracy.add_argument("--rays", type=int, default=4096, help="random rays per row")
     accuracy.add_argument("--height-scale", type=float, default=0.05, help="relief depth in UV units")
-    accuracy.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    add_backend_option(accuracy)
     accuracy.set_defaults(func=cmd_accuracy)
 
-    bench = measurement_parser(
-        sub, "bench", "speed against error of every technique (results.csv, report.md, plots)",
-        "output folder (results.csv, report.md, *.png)",
-        "full: real GPUs (1920x1080, all maps and angles); smoke: minutes on a software adapter", backend_help)
-    bench.add_argument("--resolution", help="frame WIDTHxHEIGHT (default: the suite's; full: 1920x1080)")
-    bench.add_argument("--heightmaps", help="comma-separated: builtins and/or scikit-image brick,grass,gravel")
-    bench.add_argument("--techniques", help="comma-separated technique names (default: all registered)")
-    bench.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 89)")
-    bench.add_argument("--frames", type=int, help="timed frames per configuration (median; default: the suite's)")
-    bench.add_argument("--simd-tile", help="WIDTHxHEIGHT pixels of the SIMD group for the fetches_simd cost (default 8x4)")
-    bench.add_argument("--from-csv", nargs="+", metavar="CSV",
-                       help="measure nothing: write report.md and plots from these results.csv files into --out")
-    bench.set_defaults(func=cmd_bench)
-
-    perspective = measurement_parser(
-        sub, "perspective", "perspective-correct texturing study (seed 001): speed and float error of Heckbert's "
-        "direct, incremental and parallel forms", "output folder (results.csv, report.md, *.png)",
-        "full: every sweep, 4K frames (minutes on a software adapter); smoke: seconds, for CI", backend_help)
-    perspective.set_defaults(func=cmd_perspective)
-
-    filtering = measurement_parser(
-        sub, "filtering", "texture filters on relief against a supersampled reference (results.csv, report.md, "
-        "pareto.png, crops)", "output folder",
-        "full: every filter x derivative source on 150 cases (real GPUs); smoke: 3 cases, under 2 minutes on a "
-        "software adapter", backend_help)
-    filtering.add_argument("--size", help="frame WIDTHxHEIGHT (default: the suite's)")
-    filtering.add_argument("--frames", type=int, help="timed frames per configuration (median)")
-    filtering.add_argument("--reliefs", help="comma-separated: bricks, step, wall, flat0")
-    filtering.add_argument("--albedos", help="comma-separated: own, checker, stripes, photo")
-    filtering.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 86)")
-    filtering.add_argument("--footprints", help="comma-separated texels per pixel at the frame centre, e.g. 1,4")
-    filtering.add_argument("--filters", help="comma-separated filter names (trilinear, the baseline, always runs)")
-    filtering.set_defaults(func=cmd_filtering)
-
-    refined = measurement_parser(
-        sub, "refined-distance", "fetches of the distance tracer on every distance-map variant (seed 000), on the "
-        "benchmark's views (results.csv, report.md)", "output folder (results.csv, report.md)",
-        "smoke: two small maps, two angles; full: the benchmark's real maps and wall, 0-80 degrees", backend_help)
-    refined.add_argument("--heightmaps", help="comma-separated: builtins and/or scikit-image brick,grass,gravel")
-    refined.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 85)")
-    refined.set_defaults(func=cmd_refined_distance)
+    for study in measurement_commands():
+        register(sub, study)
 
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
-    info.add_argument("--backend", choices=BACKEND_CHOICES, help=backend_help)
+    add_backend_option(info)
     info.set_defaults(func=cmd_info)
-    return parser
-
-
-COMMANDS = ("view", "render", "techniques", "filters", "accuracy", "bench", "filtering", "perspective",
-            "refined-distance", "info")
+    return parser, tuple(sub.choices)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Exit codes (wgpuviewer.core.cli): 0 ok, 1 a check failed, 2 a user error, 3 an internal error."""
+    from wgpuviewer.harness.study import command_line
+
     prepare_process("wgpuviewer")  # before any GPU driver loads
-    argv = list(sys.argv[1:] if argv is None else argv)
-    if not argv or (argv[0] not in COMMANDS and argv[0] not in ("-h", "--help")):
-        argv = ["view", *argv]  # `wgpuviewer [SCENE] [--technique ...]` means view
+    given = list(sys.argv[1:] if argv is None else argv)
 
     def command() -> int:
-        args = build_parser().parse_args(argv)
+        parser, commands = build_parser()
+        words = given if given and (given[0] in commands or given[0] in ("-h", "--help")) else ["view", *given]
+        args = parser.parse_args(words)  # `wgpuviewer [SCENE] [--technique ...]` means view
+        args.command_line = command_line(words)  # what the reports record
         return args.func(args)
 
     try:

@@ -1,11 +1,10 @@
-"""report.md and plots of a benchmark run (run.py)."""
+"""report.md of a benchmark run (run.py): the headline per error budget, the thesis' Table 4.1 redone with error,
+the per-height-map tables, map memory, which cost predicts the time, and the run's own figures."""
 
 from __future__ import annotations
 
-import io
 import math
 from collections import defaultdict
-from pathlib import Path
 
 import numpy as np
 
@@ -14,7 +13,7 @@ HEADLINE_MAX_ANGLE = 80.0  # the headline asks for the budget at every angle up 
 #: The configuration the headline's winner is compared with (the winner of the first H100 run).
 REFERENCE_CONFIG = ("distance", "iterations=256")
 
-#: Thesis Table 4.1 (papers.md, 002): FPS per angle for POM 4/8/16/24/32 layers and adaptive 4-32.
+#: Table 4.1 of the adaptive-POM thesis: FPS per angle for POM 4/8/16/24/32 layers and adaptive 4-32.
 THESIS_ANGLES = (0.0, 45.0, 60.0, 80.0)
 THESIS_LAYERS = (4, 8, 16, 24, 32)
 THESIS_FPS = {
@@ -26,11 +25,11 @@ THESIS_FPS = {
 ADAPTIVE = "pom_adaptive"
 
 
-def _key(v: dict) -> tuple[str, str]:
+def config_key(v: dict) -> tuple[str, str]:
     return v["technique"], v["params"]
 
 
-def _label(key) -> str:
+def config_label(key) -> str:
     technique, params = key
     return technique if params == "-" else f"{technique} {params}"
 
@@ -65,7 +64,7 @@ def headline(values: list[dict], max_angle: float = HEADLINE_MAX_ANGLE) -> list[
     by_config = defaultdict(list)
     for v in values:
         if v["angle"] <= max_angle:
-            by_config[_key(v)].append(v)
+            by_config[config_key(v)].append(v)
     out = []
     for budget in BUDGETS:
         meeting = [{"budget": budget, "config": key, "ratio": _geomean(v["ratio_to_basic"] for v in vs),
@@ -91,7 +90,7 @@ def cost_of(vs: list[dict]) -> dict:
 
 def reference_cost(values: list[dict], max_angle: float = HEADLINE_MAX_ANGLE) -> dict | None:
     """REFERENCE_CONFIG's geometric-mean time ratio and costs over the headline's measurements (None if not run)."""
-    vs = [v for v in values if _key(v) == REFERENCE_CONFIG and v["angle"] <= max_angle]
+    vs = [v for v in values if config_key(v) == REFERENCE_CONFIG and v["angle"] <= max_angle]
     if not vs:
         return None
     return {"ratio": _geomean(v["ratio_to_basic"] for v in vs), **cost_of(vs)}
@@ -117,7 +116,7 @@ def per_angle_budget(values: list[dict]) -> dict:
     """(budget, angle) -> (config, ratio) cheapest with p95 <= budget on every height map at that angle."""
     groups = defaultdict(lambda: defaultdict(list))
     for v in values:
-        groups[v["angle"]][_key(v)].append(v)
+        groups[v["angle"]][config_key(v)].append(v)
     out = {}
     for angle, configs in groups.items():
         for budget in BUDGETS:
@@ -249,10 +248,8 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
     suite = meta["suite"]
     w, h = suite.resolution
     lines = [
-        f"# wgpuviewer benchmark: speed against error ({suite.name} suite)", "",
-        f"- adapter: **{meta['adapter']}** (backend {meta['backend']})",
-        f"- date: {meta['date']}",
-        f"- command: `{meta['command']}`",
+        *meta["header"].lines(),
+        f"- backend: {meta['backend']}",
         f"- frame: {w}×{h}; timer: {meta['timer']} (median of {suite.frames} frames after {suite.warmup} "
         f"warm-up rounds, configurations interleaved frame by frame)",
         f"- height maps: {', '.join(dict.fromkeys(v['heightmap'] for v in values)) or 'none'}; "
@@ -289,7 +286,7 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
         if hl["config"] is None:
             lines.append(f"| ≤ {hl['budget']:g} | none of the measured configurations | – | – | – | – |")
         else:
-            lines.append(f"| ≤ {hl['budget']:g} | {_label(hl['config'])} | {_f(hl['ratio'])} | "
+            lines.append(f"| ≤ {hl['budget']:g} | {config_label(hl['config'])} | {_f(hl['ratio'])} | "
                          f"{_f(hl['fetches'], 1)} | {_f(hl['simd'], 1)} | {_f(hl['worst_p95'])} |")
     if meta["software"]:
         lines += ["", "**Software adapter: these time ratios are llvmpipe's (CPU time of an emulated GPU). The GPU "
@@ -303,7 +300,7 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
     if close:
         lines.append("")
         for hl in close:
-            others = ", ".join(f"{_label(m['config'])} {_f(m['ratio'])}× ({_f(m['simd'], 1)} SIMD-tile fetches)"
+            others = ", ".join(f"{config_label(m['config'])} {_f(m['ratio'])}× ({_f(m['simd'], 1)} SIMD-tile fetches)"
                                for m in hl["close"])
             lines.append(f"- ≤ {hl['budget']:g}: within {CLOSE_MARGIN:.0%} of the winner's time: {others}" +
                          (" — on a software adapter such a difference is within run-to-run noise." if meta["software"]
@@ -313,9 +310,9 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
         lines.append("")
         for hl in winners:
             if hl["config"] is not None and hl["config"] != REFERENCE_CONFIG:
-                lines.append(f"- ≤ {hl['budget']:g}: {_label(hl['config'])} takes {_f(hl['simd'] / ref['simd'], 3)}× the "
+                lines.append(f"- ≤ {hl['budget']:g}: {config_label(hl['config'])} takes {_f(hl['simd'] / ref['simd'], 3)}× the "
                              f"SIMD-tile fetches ({_f(hl['simd'], 1)} vs {_f(ref['simd'], 1)}) and "
-                             f"{_f(hl['ratio'] / ref['ratio'])}× the time of {_label(REFERENCE_CONFIG)} "
+                             f"{_f(hl['ratio'] / ref['ratio'])}× the time of {config_label(REFERENCE_CONFIG)} "
                              f"({_f(ref['ratio'])}× basic) over the same measurements.")
     angles = sorted({v["angle"] for v in values})
     pab = per_angle_budget(values)
@@ -325,7 +322,7 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
         cells = []
         for a in angles:
             best = pab.get((budget, a))
-            cells.append("none" if best is None else f"{_label(best[0])} ({_f(best[1])}×)")
+            cells.append("none" if best is None else f"{config_label(best[0])} ({_f(best[1])}×)")
         lines.append(f"| ≤ {budget:g} | " + " | ".join(cells) + " |")
     lines.append("")
 
@@ -343,11 +340,11 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
                   " | ".join(f"p95 {a:g}°" for a in m_angles) + " |", "|---" * (len(m_angles) + 6) + "|"]
         by_config = defaultdict(dict)
         for v in vs:
-            by_config[_key(v)][v["angle"]] = v
+            by_config[config_key(v)][v["angle"]] = v
         for key, per_angle in by_config.items():
             rows = list(per_angle.values())
             lines.append(
-                f"| {_label(key)} | {_f(float(np.mean([r['ratio_to_basic'] for r in rows])))} | "
+                f"| {config_label(key)} | {_f(float(np.mean([r['ratio_to_basic'] for r in rows])))} | "
                 f"{_f(float(np.mean([r['fetches_mean'] for r in rows])), 1)} | "
                 f"{_f(float(np.mean([r['fetches_simd'] for r in rows])), 1)} | "
                 f"{float(np.mean([r['capped_fraction'] for r in rows])):.1%} | "
@@ -381,7 +378,8 @@ def memory_section(values: list[dict]) -> list[str]:
     sizes = list(dict.fromkeys(v["heightmap_size"] for v in values))
     table = defaultdict(dict)
     for v in values:
-        table[v["technique"]][v["heightmap_size"]] = v.get("map_bytes", float("nan"))
+        size = v.get("map_bytes")  # None: a run from before the column
+        table[v["technique"]][v["heightmap_size"]] = float("nan") if size is None else float(size)
     if all(not math.isfinite(b) for t in table.values() for b in t.values()):
         return []
     lines = ["## Map memory per technique", "",
@@ -437,138 +435,3 @@ def run_section(meta: dict) -> list[str]:
             + f". GPU work per view (all {len(meta['configs'])} configurations): "
             f"{counters['submits'] / views:.1f} submits and {counters['readbacks'] / views:.1f} read-backs "
             f"({counters['submits']} and {counters['readbacks']} in all, {counters['views']} views).", ""]
-
-
-# --- plots ------------------------------------------------------------------------------------
-
-def pareto_front(points: list[tuple[float, float]]) -> list[int]:
-    """Indices of the points no other point beats in both x and y (lower is better), by x."""
-    order = sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1]))
-    front, best_y = [], math.inf
-    for i in order:
-        if points[i][1] < best_y:
-            front.append(i)
-            best_y = points[i][1]
-    return front
-
-
-def plots(out: Path, values: list[dict]) -> tuple[list[str], str | None]:
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return [], "Plots skipped: matplotlib is not installed (pip install 'wgpuviewer[bench]')."
-    written = []
-    maps = list(dict.fromkeys(v["heightmap"] for v in values))
-    techniques = list(dict.fromkeys(v["technique"] for v in values))
-    # one colour per technique (tab20 once there are more than ten), one line style per configuration of it
-    palette = plt.cm.tab10 if len(techniques) <= 10 else plt.cm.tab20
-    colors = {t: palette(i % palette.N) for i, t in enumerate(techniques)}
-    floor = 1e-3  # p95 of 0 drawn at this value on the log axis
-
-    cols = min(3, len(maps)) or 1
-    rows_n = max(1, math.ceil(len(maps) / cols))
-    fig, axes = plt.subplots(rows_n, cols, figsize=(4.2 * cols, 3.4 * rows_n), squeeze=False)
-    for ax, m in zip(axes.ravel(), maps):
-        by_config = defaultdict(list)
-        for v in values:
-            if v["heightmap"] == m:
-                by_config[_key(v)].append(v)
-        keys = list(by_config)
-        pts = [(float(np.mean([v["ratio_to_basic"] for v in by_config[k]])),
-                max(float(np.mean([v["uv_err_p95"] for v in by_config[k]])), floor)) for k in keys]
-        for k, (x, y) in zip(keys, pts):
-            ax.scatter(x, y, color=colors[k[0]], s=14)
-        front = pareto_front(pts)
-        ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=0.8)
-        for n, i in enumerate(sorted(front, key=lambda i: pts[i][0])):
-            # neighbours along the front alternate above and below their point, so their labels do not overlap
-            ax.annotate(_label(keys[i]).replace("layers=", ""), pts[i], fontsize=6,
-                        xytext=(4, 3 if n % 2 == 0 else -9), textcoords="offset points")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        _plain_ratio_ticks(ax.xaxis, [x for x, _ in pts])
-        ax.set_title(m, fontsize=9)
-        ax.set_xlabel("GPU time / basic (mean over angles)", fontsize=7)
-        ax.set_ylabel("p95 UV error, texels (mean over angles)", fontsize=7)
-        ax.tick_params(labelsize=6)
-    for ax in axes.ravel()[len(maps):]:
-        ax.axis("off")
-    handles = [plt.Line2D([], [], marker="o", ls="", color=colors[t], label=t) for t in techniques]
-    fig.legend(handles=handles, loc="lower center", ncol=min(len(techniques), 7), fontsize=7)
-    fig.tight_layout(rect=(0, 0.04 + 0.035 * math.ceil(len(techniques) / 7), 1, 1))
-    _save(fig, out / "pareto.png")
-    plt.close(fig)
-    written.append("pareto.png")
-
-    fig, ax = plt.subplots(figsize=(10, 4.8))
-    by_config = defaultdict(lambda: defaultdict(list))
-    for v in values:
-        by_config[_key(v)][v["angle"]].append(v["fetches_mean"])
-    styles = ("-", "--", ":", "-.")
-    seen = defaultdict(int)
-    for k, per_angle in by_config.items():
-        angles = sorted(per_angle)
-        ax.plot(angles, [np.mean(per_angle[a]) for a in angles], marker=".", color=colors[k[0]],
-                ls=styles[seen[k[0]] % len(styles)], lw=0.9, label=_label(k))
-        seen[k[0]] += 1
-    ax.set_yscale("symlog", linthresh=1)
-    ax.set_xlabel("view angle at the frame centre (degrees)")
-    ax.set_ylabel("depth fetches per pixel (mean over height maps)")
-    ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5))
-    fig.tight_layout()
-    _save(fig, out / "fetches_vs_angle.png")
-    plt.close(fig)
-    written.append("fetches_vs_angle.png")
-
-    c = cost_correlation(values)
-    if c["rows"] >= 3:
-        rows = [v for v in values if math.isfinite(v.get("fetches_simd", float("nan")))]
-        fig, axes = plt.subplots(1, 2, figsize=(10.5, 4), sharey=True)
-        for ax, column, title, r in ((axes[0], "fetches_mean", "mean fetches per pixel", c["mean"]),
-                                      (axes[1], "fetches_simd", "SIMD-tile fetches", c["simd"])):
-            for t in techniques:
-                vs = [v for v in rows if v["technique"] == t]
-                ax.scatter([v[column] for v in vs], [v["ratio_to_basic"] for v in vs], s=8, color=colors[t], label=t)
-            ax.set_xscale("symlog", linthresh=1)
-            ax.set_yscale("log")
-            ax.set_xlabel(title)
-            ax.set_title(f"Pearson r = {r:.3f} (all rows)", fontsize=9)
-        axes[0].set_ylabel("time / basic")
-        axes[1].legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5))
-        fig.tight_layout()
-        _save(fig, out / "cost_vs_time.png")
-        plt.close(fig)
-        written.append("cost_vs_time.png")
-    return written, None
-
-
-def _plain_ratio_ticks(axis, values) -> None:
-    """Ticks of a log axis of time ratios as plain numbers (1, 1.5, 2, 3, ...) instead of powers of ten."""
-    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator, ScalarFormatter
-
-    lo, hi = min(values), max(values)
-    ticks = [t for t in (1, 1.5, 2, 3, 4, 6, 8, 10, 15, 20, 30, 40, 60, 80, 100) if lo / 1.3 <= t <= hi * 1.3]
-    axis.set_major_locator(FixedLocator(ticks or [1]))
-    axis.set_major_formatter(ScalarFormatter())
-    axis.set_minor_locator(NullLocator())
-    axis.set_minor_formatter(NullFormatter())
-
-
-def _save(fig, path: Path) -> None:
-    from wgpuviewer.core.io import write_bytes
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=72, bbox_inches="tight")  # outside legends included
-    write_bytes(path, buf.getvalue())
-
-
-def write_outputs(out: Path, rows, meta: dict) -> None:
-    values = [r.values for r in rows]
-    written, note = plots(Path(out), values) if values else ([], "No rows: no plots.")
-    text = report(values, meta, written, note)
-    from wgpuviewer.core.io import write_bytes
-
-    write_bytes(Path(out) / "report.md", text.encode("utf-8"))

@@ -18,8 +18,6 @@ defaults, so new techniques are benchmarked without changes here.
 
 from __future__ import annotations
 
-import csv
-import datetime
 import platform
 import sys
 import tempfile
@@ -29,8 +27,10 @@ from pathlib import Path
 
 import numpy as np
 
-from wgpuviewer.core import io as core_io
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.harness import suite as harness_suite
+from wgpuviewer.harness.header import Clock, Header
+from wgpuviewer.harness.table import Column, Table
 from wgpuviewer.relief.techniques import TECHNIQUES, resolve_params
 
 #: Parameter settings per technique name (overrides of the registry defaults). Settings naming a
@@ -59,8 +59,7 @@ ALL_ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 89.0)
 
 
 @dataclass(frozen=True)
-class Suite:
-    name: str
+class Suite(harness_suite.Suite):
     heightmaps: tuple[str, ...]
     angles: tuple[float, ...]
     resolution: tuple[int, int]
@@ -74,23 +73,33 @@ class Suite:
     reference_workers: int = 0  # processes for the float64 reference hits (0: in this process)
 
 
-SUITES = {
-    "smoke": Suite("smoke", ("brick", "bricks", "spike"), (0.0, 45.0, 60.0, 80.0, 89.0), (96, 54), 30, 3,
-                   SMOKE_SWEEPS, eval_pixels=1500, builtin_size=128, real_size=256),
+SUITES = harness_suite.suites(
+    Suite("smoke", ("brick", "bricks", "spike"), (0.0, 45.0, 60.0, 80.0, 89.0), (96, 54), 30, 3,
+          SMOKE_SWEEPS, eval_pixels=1500, builtin_size=128, real_size=256),
     # 20 frames after 2 warm-up rounds: the whole suite in one 8-minute run on an H100-class GPU (docs/benchmarks.md)
-    "full": Suite("full", REAL_MAPS + SYNTHETIC_MAPS, ALL_ANGLES, (1920, 1080), 20, 2, SWEEPS,
-                  eval_pixels=32768, builtin_size=256, reference_workers=-1),
-}
-
-COLUMNS = (
-    "suite", "heightmap", "heightmap_size", "technique", "params", "angle", "angle_min", "angle_max",
-    "resolution", "adapter", "backend", "timer", "frames", "gpu_ms", "basic_ms", "ratio_to_basic",
-    "fetches_mean", "fetches_p95", "uv_err_mean", "uv_err_p95", "uv_err_max", "psnr_db",
-    "capped_fraction", "covered_fraction", "eval_pixels",
-    # added by issue 13: the divergence-aware cost (mean over screen tiles of the tile's largest fetch count), the
-    # tile it was computed for, and the memory of the height-derived maps the technique samples
-    "fetches_simd", "simd_tile", "map_bytes",
+    Suite("full", REAL_MAPS + SYNTHETIC_MAPS, ALL_ANGLES, (1920, 1080), 20, 2, SWEEPS,
+          eval_pixels=32768, builtin_size=256, reference_workers=-1),
 )
+
+#: results.csv: one row per height map x configuration x angle.
+TABLE = Table("benchmark results", (
+    Column("suite", str), Column("heightmap", str), Column("heightmap_size", str, "texels, WxH"),
+    Column("technique", str), Column("params", str), Column("angle", float, "degrees at the frame centre"),
+    Column("angle_min", float, "degrees"), Column("angle_max", float, "degrees"),
+    Column("resolution", str, "pixels, WxH"), Column("adapter", str), Column("backend", str), Column("timer", str),
+    Column("frames", int, "timed frames"), Column("gpu_ms", float, "ms, median"), Column("basic_ms", float, "ms"),
+    Column("ratio_to_basic", float, "x"), Column("fetches_mean", float, "depth fetches per pixel"),
+    Column("fetches_p95", float, "depth fetches per pixel"), Column("uv_err_mean", float, "texels"),
+    Column("uv_err_p95", float, "texels"), Column("uv_err_max", float, "texels"), Column("psnr_db", float, "dB"),
+    Column("capped_fraction", float, "of the covered pixels"), Column("covered_fraction", float, "of the frame"),
+    Column("eval_pixels", int, "pixels"),
+    # the divergence-aware cost (mean over screen tiles of the tile's largest fetch count), the tile it was computed
+    # for, and the memory of the height-derived maps the technique samples; the first H100 runs lack them
+    Column("fetches_simd", float, "depth fetches per SIMD tile", optional=True, default=float("nan")),
+    Column("simd_tile", str, "pixels, WxH", optional=True, default=""),
+    Column("map_bytes", int, "bytes", optional=True),
+))
+COLUMNS = TABLE.names
 
 
 def params_label(params: dict) -> str:
@@ -140,13 +149,11 @@ class Options:
 
 
 def resolve_options(suite_name: str, resolution=None, heightmaps=None, techniques=None, angles=None,
-                    frames=None, backend=None, command="", simd_tile=None) -> Options:
+                    frames=None, backend=None, command="wgpuviewer bench", simd_tile=None) -> Options:
     """Validated run options (UserError naming the option on bad input)."""
     from wgpuviewer.textures import BUILTINS
 
-    if suite_name not in SUITES:
-        raise UserError(f"--suite {suite_name!r}: unknown; expected one of {', '.join(SUITES)}")
-    suite = SUITES[suite_name]
+    suite = harness_suite.pick(SUITES, suite_name)
     notes = []
     if resolution is not None:
         suite = replace(suite, resolution=tuple(resolution))
@@ -288,7 +295,6 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     from wgpuviewer.relief.renderer import DrawConfig, Renderer
 
     from .capture import capture
-    from .report import write_outputs
     from .timing import time_configs
     from .view import load_heightmap, make_view, reference_pool
 
@@ -305,12 +311,12 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     busy = []
     counters = {"submits": 0, "readbacks": 0}
     phases = {}
-    started = datetime.datetime.now(datetime.UTC)
+    clock = Clock()
     total = len(suite.heightmaps) * len(suite.angles) * len(configs)
     with tempfile.TemporaryDirectory(prefix="wgpuviewer-bench-") as workdir, \
             tqdm(total=total, desc="bench", unit="row", file=sys.stderr, disable=not progress) as bar:
         # (1) height maps, views and every map the configurations sample
-        clock = time.perf_counter()
+        phase_start = time.perf_counter()
         work = []  # (heightmap, views, the renderer whose maps and pipelines its views share, map bytes per technique)
         for map_name in suite.heightmaps:
             try:
@@ -329,9 +335,9 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
             first = Renderer(views[0].scene, gpu)  # the views of this map share its maps and pipelines
             sizes = {name: map_bytes(first, "relief", name) for name in dict.fromkeys(n for n, _ in configs)}
             work.append((heightmap, views, first, sizes))
-        phases["maps"] = time.perf_counter() - clock
+        phases["maps"] = time.perf_counter() - phase_start
         # (2) reference hits, all views at once (a pool works on them while the GPU part runs)
-        clock = time.perf_counter()
+        phase_start = time.perf_counter()
         pending = reference_pool([v for _, views, _, _ in work for v in views], suite.eval_pixels,
                                  suite.reference_workers)
         gpu_s = 0.0
@@ -342,7 +348,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
                 new_rows = processing.pop(0).result()
                 rows.extend(new_rows)
                 bar.update(len(new_rows))
-                write_csv(out / "results.csv", [r.values for r in rows])  # partial results survive a kill
+                TABLE.write(out / "results.csv", [r.values for r in rows])  # partial results survive a kill
 
         with ThreadPoolExecutor(max_workers=1) as worker:
             for index, (heightmap, views, first, sizes) in enumerate(work):
@@ -363,53 +369,46 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
                 work[index] = (heightmap, views, None, sizes)  # this height map is done: free its maps and pipelines
             collect(block=True)
         phases["gpu"] = gpu_s
-        phases["references and errors, not overlapped with the GPU part"] = time.perf_counter() - clock - gpu_s
-    finished = datetime.datetime.now(datetime.UTC)
+        phases["references and errors, not overlapped with the GPU part"] = time.perf_counter() - phase_start - gpu_s
     meta = {
+        "header": clock.header(TITLE.format(suite=suite.name), options.command, adapter, suite.name),
         "suite": suite, "adapter": adapter, "backend": backend, "software": gpu.software,
-        "timer": rows[0].values["timer"] if rows else "", "command": options.command,
-        "date": f"{started:%Y-%m-%d %H:%M} UTC (took {(finished - started).total_seconds():.0f} s)",
+        "timer": rows[0].values["timer"] if rows else "",
         "notes": options.notes, "configs": configs,
         "techniques": options.techniques, "busy_max": max(busy) if busy else float("nan"),
         "python": platform.python_version(), "platform": platform.platform(),
         "phases": phases, "counters": {**counters, "views": sum(len(w[1]) for w in work)},
     }
-    write_csv(out / "results.csv", [r.values for r in rows])
+    TABLE.write(out / "results.csv", [r.values for r in rows])
     write_outputs(out, rows, meta)
     return [r.values for r in rows]
 
 
-def write_csv(path: Path, rows: list[dict]) -> None:
-    core_io.write_csv(path, COLUMNS, rows)
+def write_outputs(out: Path, rows: list[Row], meta: dict) -> None:
+    """report.md and the plots of ``rows`` into ``out``."""
+    from wgpuviewer.core.io import write_bytes
+
+    from .plots import plots
+    from .report import report
+
+    values = [r.values for r in rows]
+    written, note = plots(out, values) if values else ([], "No rows: no plots.")
+    write_bytes(out / "report.md", report(values, meta, written, note).encode("utf-8"))
 
 
-#: Text columns of results.csv (the others are numbers).
-TEXT_COLUMNS = {"suite", "heightmap", "heightmap_size", "technique", "params", "resolution", "adapter", "backend",
-                "timer", "simd_tile"}
+#: The report's title (harness.header).
+TITLE = "wgpuviewer benchmark: speed against error ({suite} suite)"
 
 
-def read_csv(path: Path) -> list[dict]:
-    """results.csv back as dicts with numbers parsed (for tests and re-reporting). Columns added after a file was
-    written (e.g. fetches_simd in the H100 run) read as NaN (numbers) or "" (text)."""
-    with open(path, newline="", encoding="utf-8") as f:
-        rows = list(csv.DictReader(f))
-    out = []
-    for row in rows:
-        values = {k: (v if k in TEXT_COLUMNS else float(v) if v != "" else float("nan")) for k, v in row.items()}
-        out.append({**{k: "" if k in TEXT_COLUMNS else float("nan") for k in COLUMNS}, **values})
-    return out
-
-
-def rereport(csv_paths: list[Path], out: Path, command: str = "") -> list[dict]:
+def rereport(csv_paths: list[Path], out: Path, command: str = "wgpuviewer bench") -> list[dict]:
     """report.md and plots again from one or more results.csv files (e.g. parts of one run)."""
-    from .report import write_outputs
 
     values = []
     for path in csv_paths:
         try:
-            values += read_csv(Path(path))
-        except (OSError, KeyError, ValueError) as e:
-            raise UserError(f"--from-csv {path}: cannot read benchmark results ({e})") from None
+            values += TABLE.read(path)
+        except UserError as e:
+            raise UserError(f"--from-csv {e}") from None
     if not values:
         raise UserError("--from-csv: no rows in " + ", ".join(map(str, csv_paths)))
     first = values[0]
@@ -420,16 +419,18 @@ def rereport(csv_paths: list[Path], out: Path, command: str = "") -> list[dict]:
                     angles=tuple(sorted({v["angle"] for v in values})))
     configs = list(dict.fromkeys((v["technique"], v["params"]) for v in values))
     adapters = sorted({v["adapter"] for v in values})
+    adapter = " / ".join(adapters)
     meta = {
-        "suite": suite, "adapter": " / ".join(adapters), "backend": first["backend"],
+        "header": Header(TITLE.format(suite=suite.name), command, adapter, suite.name, None, None,
+                         tuple(Path(p).name for p in csv_paths)),
+        "suite": suite, "adapter": adapter, "backend": first["backend"],
         "software": "(CPU)" in first["adapter"] or "llvmpipe" in first["adapter"], "timer": first["timer"],
-        "command": command, "date": "see the results' source; regenerated from " + ", ".join(Path(p).name for p in csv_paths),
         "notes": [] if len(adapters) == 1 else ["rows from several adapters: compare ratios per adapter only"],
         "configs": configs, "techniques": list(dict.fromkeys(v["technique"] for v in values)),
         "busy_max": float("nan"), "python": platform.python_version(), "platform": platform.platform(),
     }
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    write_csv(out / "results.csv", values)
+    TABLE.write(out / "results.csv", values)
     write_outputs(out, [Row(v, np.empty(0)) for v in values], meta)
     return values

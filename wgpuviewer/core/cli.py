@@ -1,5 +1,6 @@
 """What both command lines (``wgpuviewer`` and ``maptools``) share: preparing the process before any GPU driver
-loads, warnings as one line each, argparse errors as one line, and the exit codes.
+loads, warnings as one line each, argparse errors as one line, option values checked into one-line errors
+(sizes, comma-separated lists, the backend), and the exit codes.
 
 Exit codes: 0 success, 1 a check or batch job failed (the commands return it), 2 a user error (``UserError`` or
 ``InputError``: one line naming the thing and the fix), 3 an internal error (a bug: a one-line summary, and the
@@ -126,6 +127,46 @@ def terminal_progress(what: str, delay: float = 1.0):
         stop.set()
         if "bar" in state:
             state["bar"].close()
+
+
+def parse_size(text: str, option: str = "--size") -> tuple[int, int]:
+    """``WIDTHxHEIGHT`` as (width, height), each 1 to 16384; a UserError naming ``option`` otherwise."""
+    try:
+        w, h = (int(part) for part in text.lower().split("x"))
+    except ValueError:
+        raise UserError(f"{option} {text!r}: expected WIDTHxHEIGHT, e.g. 1280x720") from None
+    if not (1 <= w <= 16384 and 1 <= h <= 16384):
+        raise UserError(f"{option} {text!r}: width and height must be 1 to 16384")
+    return w, h
+
+
+def comma_list(text: str | None, option: str) -> list[str] | None:
+    """A comma-separated option value as a list (None when the option was not given)."""
+    if text is None:
+        return None
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    if not items:
+        raise UserError(f"{option} {text!r}: expected a comma-separated list, e.g. a,b")
+    return items
+
+
+def comma_numbers(text: str | None, option: str, example: str) -> list[float] | None:
+    """A comma-separated option value as numbers (None when not given); ``example`` shows a valid value."""
+    items = comma_list(text, option)
+    if items is None:
+        return None
+    try:
+        return [float(x) for x in items]
+    except ValueError:
+        raise UserError(f"{option} {text!r}: expected comma-separated numbers, e.g. {example}") from None
+
+
+def add_backend_option(parser) -> None:
+    """``--backend auto|vulkan|metal|dx12|gl`` (imports the GPU module: call it while building a parser)."""
+    from .gpu import BACKEND_CHOICES, BACKEND_ENV
+
+    parser.add_argument("--backend", choices=BACKEND_CHOICES,
+                        help=f"wgpu backend (default: ${BACKEND_ENV} or auto: hardware first, then software)")
 
 
 class OneLineParser(argparse.ArgumentParser):

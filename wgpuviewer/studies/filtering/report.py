@@ -1,22 +1,22 @@
-"""The filtering study's outputs: ``results.csv`` (one row per case x configuration), ``report.md`` (the answer to
-seed 003's question with the numbers behind it), ``pareto.png`` (error against GPU time) and side-by-side crops
-(``crops_CASE.png``: reference and filters, with their difference images)."""
+"""The filtering study's outputs: ``results.csv`` (one row per case x configuration, ``suites.TABLE``),
+``report.md`` (the answer to the filtering paper's question with the numbers behind it), ``pareto.png`` (error
+against GPU time) and side-by-side crops (``crops_CASE.png``: reference and filters, with their difference
+images)."""
 
 from __future__ import annotations
 
-import csv
-import io
 import math
-import time
 from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
 
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.io import atomic_open, write_bytes
+from wgpuviewer.core.io import write_bytes
+from wgpuviewer.harness.header import Header
+from wgpuviewer.harness.plots import pyplot, save_png
 
-from .suites import BASELINE, COLUMNS, Config, Options, Suite
+from .suites import BASELINE, TABLE, Config, Options, Suite
 from .views import ALBEDOS, HEIGHT_SCALE, RELIEFS, TECHNIQUE, Case
 
 #: The crops' panels: the reference, then these configurations (label, Config), then their difference images.
@@ -41,42 +41,14 @@ def wanted_for_pictures(case: Case, suite: Suite) -> bool:
             and case.footprint == min(footprints))
 
 
-def write(out: Path, rows: list[dict], kept: list, options: Options, elapsed: float) -> None:
-    write_csv(out / "results.csv", rows)
+TITLE = "Texture filtering on relief surfaces (Romanyuk & Dudnyk 2017)"
+
+
+def write(out: Path, rows: list[dict], kept: list, options: Options, header: Header) -> None:
+    TABLE.write(out / "results.csv", rows)
     pictures = [write_crops(out, result) for result in kept]
     pareto = write_pareto(out / "pareto.png", rows)
-    write_bytes(out / "report.md", markdown(rows, options, elapsed, pictures, pareto).encode())
-
-
-def write_csv(path: Path, rows: list[dict]) -> None:
-    text = io.StringIO()
-    writer = csv.DictWriter(text, fieldnames=COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: _fmt(row.get(k, "")) for k in COLUMNS})
-    write_bytes(path, text.getvalue().encode())
-
-
-def read_csv(path: Path) -> list[dict]:
-    try:
-        with open(path, newline="") as f:
-            rows = list(csv.DictReader(f))
-    except OSError as error:
-        raise UserError(f"{path}: cannot read ({error.strerror})") from None
-    numeric = {"angle", "footprint", "time_ratio", "gpu_ms", "psnr", "ssim", "psnr_gauss", "psnr_occluded",
-               "occluded_share", "texels_per_pixel", "depth_fetches_per_pixel", "hidden_per_pixel", "capped_share",
-               "bounded_share", "ratio_p50", "ratio_p99", "ratio_max", "reference_psnr_half", "pixels"}
-    for row in rows:
-        for k in numeric & row.keys():
-            row[k] = float(row[k]) if row[k] not in ("", "nan") else float("nan")
-        row["occluding"] = row.get("occluding") == "True"
-    return rows
-
-
-def _fmt(value):
-    if isinstance(value, float):
-        return "nan" if math.isnan(value) else f"{value:.6g}"
-    return value
+    write_bytes(out / "report.md", markdown(rows, options, header, pictures, pareto).encode())
 
 
 # --- aggregation ---------------------------------------------------------------------------------------------
@@ -168,14 +140,13 @@ def write_crops(out: Path, result) -> str:
 
 
 def write_pareto(path: Path, rows: list[dict]) -> str | None:
-    """PSNR (mean over occluding cases, and over flat ones) against the time ratio, one point per configuration."""
-    try:
-        import matplotlib
+    """PSNR (mean over occluding cases, and over flat ones) against the time ratio, one point per configuration;
+    None without matplotlib."""
+    with pyplot() as plt:
+        return None if plt is None else _draw_pareto(plt, path, rows)
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return None
+
+def _draw_pareto(plt, path: Path, rows: list[dict]) -> str:
     fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharey=False)
     for ax, occluding in zip(axes, (True, False)):
         subset = [r for r in rows if r["occluding"] == occluding]
@@ -201,12 +172,9 @@ def write_pareto(path: Path, rows: list[dict]) -> str | None:
         ax.set_xlabel("GPU time / trilinear (same run, geometric mean)")
         ax.set_ylabel("PSNR against the box reference, dB (mean)")
         ax.set_title("relief with occlusion" if occluding else "flat relief")
-        ax.grid(True, which="both", alpha=0.3)
+        ax.grid(True, which="both")
     fig.tight_layout()
-    with atomic_open(path) as f:
-        fig.savefig(f, format="png", dpi=120)
-    plt.close(fig)
-    return path.name
+    return save_png(fig, path, dpi=120, tight=False)
 
 
 # --- report.md -------------------------------------------------------------------------------------------------
@@ -274,18 +242,17 @@ def _delta(psnrs: dict, a: str, b: str) -> str:
     return f"{psnrs[a] - psnrs[b]:+.2f}" if a in psnrs and b in psnrs else "–"
 
 
-def markdown(rows: list[dict], options: Options, elapsed: float, pictures: list[str], pareto: str | None) -> str:
+def markdown(rows: list[dict], options: Options, header: Header, pictures: list[str], pareto: str | None) -> str:
     suite = options.suite
-    adapter = rows[0]["adapter"] if rows else "?"
-    timer = rows[0].get("timer", "?") if rows else "?"
-    software = any(word in adapter.lower() for word in ("llvmpipe", "lavapipe", "swiftshader", "warp"))
+    timer = rows[0]["timer"] if rows else "?"
+    software = any(word in header.adapter.lower() for word in ("llvmpipe", "lavapipe", "swiftshader", "warp"))
     lines = [
-        "# Texture filtering on relief surfaces (seed 003)", "",
-        f"Command: `{options.command}`  ",
-        f"Adapter: {adapter} (timer: {timer}){' — a CPU-emulated adapter: GPU times are ratios measured side by side in one run, not real-GPU speeds' if software else ''}  ",  # noqa: E501
-        f"Suite `{suite.name}`: {len(suite.cases)} cases x {len(suite.configs)} configurations, frames "
-        f"{suite.size[0]}x{suite.size[1]}, reference {suite.reference}x{suite.reference} rays per pixel, "
-        f"{suite.frames} timed frames each (median); {elapsed:.0f} s; {time.strftime('%Y-%m-%d')}.", "",
+        *header.lines(),
+        f"- timer: {timer}" + (" — a CPU-emulated adapter: GPU times are ratios measured side by side in one run, "
+                               "not real-GPU speeds" if software else ""),
+        f"- {len(suite.cases)} cases x {len(suite.configs)} configurations, frames {suite.size[0]}x{suite.size[1]}, "
+        f"reference {suite.reference}x{suite.reference} rays per pixel, {suite.frames} timed frames each (median)",
+        "",
         f"Technique `{TECHNIQUE}` (exact hits) for every render; relief depth {HEIGHT_SCALE} UV units per tile; "
         "errors of the unlit, filtered albedo against the supersampled reference (method: docs/filtering.md).", "",
         "## The answer", "", *answer(rows), "",

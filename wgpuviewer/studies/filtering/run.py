@@ -12,14 +12,14 @@ hidden texels (``supersample.occluded_pixels``).
 from __future__ import annotations
 
 import sys
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import get_gpu
+from wgpuviewer.core.io import output_dir
+from wgpuviewer.harness.header import Clock
 from wgpuviewer.relief.filters import FLAGS
 from wgpuviewer.relief.renderer import Renderer
 
@@ -106,17 +106,13 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     from . import report
 
     suite = options.suite
-    out = Path(out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise UserError(f"--out {out}: cannot create the folder ({error.strerror})") from None
+    out = output_dir(out, "--out")
     gpu = get_gpu(options.backend)
     rows, kept = [], []
     total = len(suite.cases) * len(suite.configs)
     from tqdm import tqdm
 
-    started = time.perf_counter()
+    clock = Clock()
     with tqdm(total=total, desc="filtering", file=sys.stderr, disable=not progress, leave=False) as bar:
         for case in suite.cases:
             view = make_view(case, suite.size, out / "textures")
@@ -124,6 +120,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
             rows += case_rows
             if report.wanted_for_pictures(case, suite):
                 kept.append(result)
-    report.write(out, rows, kept, options, time.perf_counter() - started)
+    header = clock.header(report.TITLE, options.command, gpu.summary, suite.name)
+    report.write(out, rows, kept, options, header)
     return rows
 

@@ -1,11 +1,13 @@
-"""The filtering study's configurations (filter x derivative source x parameters), cases and suites, and the
-command's options narrowing them."""
+"""The filtering study's configurations (filter x derivative source x parameters), cases and suites, the columns
+of its results.csv, and the command's options narrowing the suite."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.harness import suite as harness_suite
+from wgpuviewer.harness.table import Column, Table
 from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS, get_filter
 from wgpuviewer.relief.renderer import DrawConfig
 
@@ -55,8 +57,7 @@ SMOKE_CONFIGS = (BASELINE, Config("aniso", "uv", (("max_anisotropy", 16),)), Con
 
 
 @dataclass(frozen=True)
-class Suite:
-    name: str
+class Suite(harness_suite.Suite):
     size: tuple[int, int]
     reference: int  # sub-pixel rays per pixel side (the convergence check uses half)
     cases: tuple[Case, ...]
@@ -70,22 +71,31 @@ def _cases(reliefs, albedos, angles, footprints) -> tuple[Case, ...]:
                  for fp in footprints)
 
 
-SUITES = {
-    "smoke": Suite("smoke", (48, 36), 16,
-                   (Case("bricks", "own", 80.0, 2.0), Case("bricks", "checker", 80.0, 2.0),
-                    Case("flat0", "photo", 60.0, 2.0)),
-                   SMOKE_CONFIGS, frames=3, warmup=1),
-    "full": Suite("full", (160, 120), 16,
-                  _cases(("bricks", "step", "wall"), ("own", "checker", "stripes", "photo"), (0.0, 45.0, 70.0, 80.0, 85.0),
-                         (1.0, 4.0))
-                  + _cases(("flat0",), ("checker", "stripes", "photo"), (0.0, 45.0, 70.0, 80.0, 85.0), (1.0, 4.0)),
-                  _full_configs(), frames=10),
-}
+SUITES = harness_suite.suites(
+    Suite("smoke", (48, 36), 16,
+          (Case("bricks", "own", 80.0, 2.0), Case("bricks", "checker", 80.0, 2.0), Case("flat0", "photo", 60.0, 2.0)),
+          SMOKE_CONFIGS, frames=3, warmup=1),
+    Suite("full", (160, 120), 16,
+          _cases(("bricks", "step", "wall"), ("own", "checker", "stripes", "photo"), (0.0, 45.0, 70.0, 80.0, 85.0),
+                 (1.0, 4.0))
+          + _cases(("flat0",), ("checker", "stripes", "photo"), (0.0, 45.0, 70.0, 80.0, 85.0), (1.0, 4.0)),
+          _full_configs(), frames=10),
+)
 
-COLUMNS = ("case", "relief", "albedo", "angle", "footprint", "occluding", "filter", "derivatives", "params", "label",
-           "time_ratio", "gpu_ms", "timer", "psnr", "ssim", "psnr_gauss", "psnr_occluded", "occluded_share",
-           "texels_per_pixel", "depth_fetches_per_pixel", "hidden_per_pixel", "capped_share", "bounded_share",
-           "ratio_p50", "ratio_p99", "ratio_max", "reference_psnr_half", "pixels", "adapter")
+#: results.csv: one row per case x configuration.
+TABLE = Table("filtering results", (
+    Column("case", str), Column("relief", str), Column("albedo", str), Column("angle", float, "degrees"),
+    Column("footprint", float, "texels per pixel"), Column("occluding", bool), Column("filter", str),
+    Column("derivatives", str), Column("params", str), Column("label", str),
+    Column("time_ratio", float, "x trilinear (uv)"), Column("gpu_ms", float, "ms, median"), Column("timer", str),
+    Column("psnr", float, "dB"), Column("ssim", float), Column("psnr_gauss", float, "dB"),
+    Column("psnr_occluded", float, "dB"), Column("occluded_share", float, "of the covered pixels"),
+    Column("texels_per_pixel", float, "texels"), Column("depth_fetches_per_pixel", float, "fetches"),
+    Column("hidden_per_pixel", float, "texels"), Column("capped_share", float, "of the covered pixels"),
+    Column("bounded_share", float, "of the covered pixels"), Column("ratio_p50", float, "x"),
+    Column("ratio_p99", float, "x"), Column("ratio_max", float, "x"), Column("reference_psnr_half", float, "dB"),
+    Column("pixels", int, "covered pixels"), Column("adapter", str),
+))
 
 
 @dataclass
@@ -103,7 +113,7 @@ def resolve_options(suite: str, *, size: tuple[int, int] | None = None, frames: 
     """The suite, narrowed or resized by the command's options (checked; a bad value is a UserError)."""
     from .views import ALBEDOS, HORIZON_MARGIN, RELIEFS
 
-    base = SUITES[suite]
+    base = harness_suite.pick(SUITES, suite)
     for name in reliefs or ():
         if name not in RELIEFS:
             raise UserError(f"--reliefs: unknown relief {name!r}; expected some of {', '.join(RELIEFS)}")

@@ -36,7 +36,7 @@ RELIEFS = {"bricks": "bricks (occlusion at the mortar)", "step": "one 0-to-1 ste
 OCCLUDING = ("bricks", "step", "wall")
 #: High-frequency albedos (sRGB PNGs written into the study's folder).
 #: "own": the relief builtin's own albedo, whose colour follows the height (mortar vs brick, low vs high side of a
-#: step): there the hidden texels differ from the visible ones, the case seed 003 is about.
+#: step): there the hidden texels differ from the visible ones, the case the filtering paper is about.
 ALBEDOS = {"checker": "2-texel checker (period 4 texels)", "stripes": "stripes, period 3 texels, 20 degrees off u",
            "photo": "scikit-image astronaut photograph, 256x256", "own": "the relief builtin's own albedo"}
 

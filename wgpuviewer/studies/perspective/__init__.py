@@ -1,17 +1,23 @@
-"""The perspective-correct texturing study (seed 001, Heckbert's formulas with the incremental and parallel forms of
-Romaniuk and Dudnyk): for screen pixel (x, y) of a planar polygon ``u = (A1 x + B1 y + C1) / (D x + E y + F)``, and
-the same for v; every way of evaluating it along a span, in float32 and float64, on the CPU (numpy, an exact float32
-emulation) and the GPU (WGSL compute kernels), measured for speed and for texture-coordinate error against float64.
+"""The perspective-correct texturing study (Romanyuk & Dudnyk, perspective texturing: Heckbert's formulas with their
+incremental and parallel forms): for screen pixel (x, y) of a planar polygon
+``u = (A1 x + B1 y + C1) / (D x + E y + F)``, and the same for v; every way of evaluating it along a span, in
+float32 and float64, on the CPU (numpy, an exact float32 emulation) and the GPU (WGSL compute kernels), measured
+for speed and for texture-coordinate error against float64.
 
+- ``command``: ``wgpuviewer perspective --out DIR`` (``STUDY``);
 - ``geometry``: the textured quad under a perspective camera, its coefficients from the projective
   texture-to-screen map (float64), the spans, the float64 reference;
 - ``arith``: float32/float64 arithmetic that rounds every operation and counts them (the operation counts);
 - ``methods``: the numpy form of every method and mitigation (the registry ``METHODS``);
 - ``kernels``: the same methods as WGSL compute kernels (``wgsl/studies/perspective/``), run and timed;
 - ``hardware``: the uv the rasteriser interpolates for the same quad (the renderer's ``uv`` data);
-- ``relief``: the tie-back, large texture coordinates through the relief techniques' probe;
-- ``run`` and ``report``: ``wgpuviewer perspective --out DIR``: sweeps, ``results.csv``, ``report.md``, plots.
+- ``tieback``: large texture coordinates through the relief techniques' probe;
+- ``run``, ``report`` and ``plots``: the sweeps, ``results.csv``, ``report.md``, the plots.
 
-May import: ``wgpuviewer.core``, ``wgpuviewer.relief``, the scene modules (``camera``, ``meshes``, ``scene``); only
-``wgpuviewer.cli`` imports this package.
+May import: ``wgpuviewer.core``, ``wgpuviewer.harness``, ``wgpuviewer.relief``, the scene modules (``camera``,
+``meshes``, ``scene``); the CLI registers ``STUDY``.
 """
+
+from .command import STUDY
+
+__all__ = ["STUDY"]

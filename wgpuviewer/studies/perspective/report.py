@@ -1,14 +1,13 @@
-"""``report.md`` and the plots of the perspective study, from its rows (``run.COLUMNS``). Every number in the
-report is computed here from the measurements; nothing is typed in."""
+"""``report.md`` of the perspective study, from its rows (``run.TABLE``); the plots are ``plots``. Every number in
+the report is computed here from the measurements; nothing is typed in."""
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 
-from wgpuviewer.core.io import atomic_open, write_bytes
+from wgpuviewer.harness.plots import MISSING
 
 from .methods import METHODS, PARALLEL_THREADS
 
@@ -19,7 +18,7 @@ DRIFT_BUDGETS = (0.1, 0.5, 1.0)  # texels
 
 
 def _f(x, digits: int = 3) -> str:
-    if x == "" or x is None or (isinstance(x, float) and math.isnan(x)):
+    if x is None or (isinstance(x, float) and math.isnan(x)):
         return "–"
     if isinstance(x, float) and (x == 0 or 1e-3 <= abs(x) < 1e5):
         return f"{x:.{digits}g}"
@@ -28,23 +27,23 @@ def _f(x, digits: int = 3) -> str:
     return str(x)
 
 
-def _first(rows, **match):
+def first_row(rows, **match):
     for r in rows:
         if all(r.get(k) == v for k, v in match.items()):
             return r
     return None
 
 
-def _select(rows, **match):
+def select_rows(rows, **match):
     return [r for r in rows if all(r.get(k) == v for k, v in match.items())]
 
 
-def _f32(name: str) -> str:
+def single_precision(name: str) -> str:
     return "float32" if name == "hardware" else METHODS[name].precisions[0]
 
 
 def _err(rows, sweep, method, key="max_err", **match):
-    r = _first(rows, sweep=sweep, method=method, precision=_f32(method), **match)
+    r = first_row(rows, sweep=sweep, method=method, precision=single_precision(method), **match)
     return r[key] if r else float("nan")
 
 
@@ -68,7 +67,7 @@ def fitted_length(slope: float, offset: float, budget: float) -> float:
 
 def answers(rows: list[dict], suite) -> list[str]:
     out = []
-    speed = _select(rows, sweep="speed")
+    speed = select_rows(rows, sweep="speed")
     frames = list(dict.fromkeys((r["span_length"], r["spans"]) for r in speed))
     for w, h in frames:
         here = [r for r in speed if (r["span_length"], r["spans"]) == (w, h)]
@@ -76,8 +75,8 @@ def answers(rows: list[dict], suite) -> list[str]:
                      key=lambda r: r["gpu_ratio"])
         cpu = sorted((r for r in here if r["method"] in METHODS and isinstance(r["cpu_ratio"], float)),
                      key=lambda r: r["cpu_ratio"])
-        hw = _first(here, method="hardware")
-        stepping = _first(here, method="incremental")
+        hw = first_row(here, method="hardware")
+        stepping = first_row(here, method="incremental")
         if gpu:
             top = ", ".join(f"`{r['method']}` {_f(r['gpu_ratio'])}×" for r in gpu[:4])
             spread = float(np.median([r["gpu_spread"] for r in here]))
@@ -92,7 +91,7 @@ def answers(rows: list[dict], suite) -> list[str]:
                        f"({_f(cpu[0]['cpu_ratio'])}× `direct`); the first four: {top}; `incremental` "
                        f"{_f(stepping['cpu_ratio'])}×.")
 
-    lengths = sorted({r["span_length"] for r in _select(rows, sweep="span_length")})
+    lengths = sorted({r["span_length"] for r in select_rows(rows, sweep="span_length")})
     incr = [_err(rows, "span_length", "incremental", span_length=n) for n in lengths]
     direct = [_err(rows, "span_length", "direct", span_length=n) for n in lengths]
     slope, offset, scatter = power_fit(lengths, incr)
@@ -123,9 +122,9 @@ def answers(rows: list[dict], suite) -> list[str]:
                f"{', '.join(cuts)}.")
 
     out.append(mitigation_answer(rows, longest))
-    measured = [o for o in sorted({r["offset_texels"] for r in _select(rows, sweep="magnitude")})
+    measured = [o for o in sorted({r["offset_texels"] for r in select_rows(rows, sweep="magnitude")})
                 if math.isfinite(_err(rows, "magnitude", "direct", offset_texels=o))]
-    beyond = [o for o in {r["offset_texels"] for r in _select(rows, sweep="magnitude")} if o not in measured]
+    beyond = [o for o in {r["offset_texels"] for r in select_rows(rows, sweep="magnitude")} if o not in measured]
     if measured:
         top = measured[-1]
         parts = ", ".join(f"`{m}` {_f(_err(rows, 'magnitude', m, offset_texels=top))}"
@@ -138,20 +137,20 @@ def answers(rows: list[dict], suite) -> list[str]:
 
 
 def rows_tilt(rows) -> str:
-    tilts = {r["tilt_deg"] for r in _select(rows, sweep="span_length")}
+    tilts = {r["tilt_deg"] for r in select_rows(rows, sweep="span_length")}
     return "/".join(f"{t:g}" for t in sorted(tilts))
 
 
 def mitigation_answer(rows, length) -> str:
     base = _err(rows, "span_length", "incremental", span_length=length)
     target = 2 * _err(rows, "span_length", "direct", span_length=length)
-    speed = _select(rows, sweep="speed")
+    speed = select_rows(rows, sweep="speed")
     frame = (speed[0]["span_length"], speed[0]["spans"]) if speed else (None, None)
-    t_incr = _first(speed, method="incremental", span_length=frame[0], spans=frame[1])
+    t_incr = first_row(speed, method="incremental", span_length=frame[0], spans=frame[1])
     scored = []
     for m in MITIGATIONS:
         err = _err(rows, "span_length", m, span_length=length)
-        t = _first(speed, method=m, span_length=frame[0], spans=frame[1])
+        t = first_row(speed, method=m, span_length=frame[0], spans=frame[1])
         if not (t and t_incr and err > 0 and t_incr["gpu_ratio"] > 0):
             continue
         extra = sum(t[k] - t_incr[k] for k in ("adds_per_texel", "muls_per_texel", "guards_per_texel",
@@ -180,7 +179,7 @@ def _table(header: list[str], body: list[list]) -> list[str]:
 
 
 def sweep_table(rows, sweep: str, key: str, methods, value="max_err") -> list[str]:
-    points = sorted({r[key] for r in _select(rows, sweep=sweep)})
+    points = sorted({r[key] for r in select_rows(rows, sweep=sweep)})
     header = [key, *(f"`{m}`" for m in methods)]
     body = [[p if key != "span_length" else str(int(p)), *(_err(rows, sweep, m, value, **{key: p}) for m in methods)]
             for p in points]
@@ -188,21 +187,21 @@ def sweep_table(rows, sweep: str, key: str, methods, value="max_err") -> list[st
 
 
 def speed_table(rows) -> list[str]:
-    speed = _select(rows, sweep="speed")
+    speed = select_rows(rows, sweep="speed")
     frames = list(dict.fromkeys((r["span_length"], r["spans"]) for r in speed))
     header = ["method", "precision", *(f"GPU × direct, {int(h)}×{int(w)} (spread)" for w, h in frames),
               "CPU × direct", "max error (texels)", "add", "mul", "div", "guard", "int add", "paper add/mul/div"]
     body = []
     for name in [*METHODS, "hardware"]:
-        first = _first(speed, method=name, span_length=frames[0][0], spans=frames[0][1])
+        first = first_row(speed, method=name, span_length=frames[0][0], spans=frames[0][1])
         if not first:
             continue
         ratios = []
         for w, h in frames:
-            r = _first(speed, method=name, span_length=w, spans=h)
+            r = first_row(speed, method=name, span_length=w, spans=h)
             ratios.append(f"{_f(r['gpu_ratio'])} (±{_f(r['gpu_spread'] * 50, 2)} %)" if r else "–")
         paper = f"{first['paper_adds']:g}/{first['paper_muls']:g}/{first['paper_divs']:g}" \
-            if first["paper_adds"] != "" else "–"
+            if first["paper_adds"] is not None else "–"
         if name in METHODS and METHODS[name].paper_note:
             paper += f" ({METHODS[name].paper_note})"
         body.append([f"`{name}`", first["precision"], *ratios, first["cpu_ratio"], first["max_err"],
@@ -212,14 +211,14 @@ def speed_table(rows) -> list[str]:
 
 
 def check_lines(rows) -> list[str]:
-    checked = [r for r in rows if r["gpu_max_ulp"] != ""]
+    checked = [r for r in rows if r["gpu_max_ulp"] is not None]
     ulps = max((r["gpu_max_ulp"] for r in checked), default=float("nan"))
     flags = sum(r["gpu_flag_mismatch"] for r in checked)
     f64 = [r for r in rows if r["precision"] == "float64" and r["family"] == "paper" and r["tilt_deg"] < 90
            and isinstance(r["max_err"], float) and not math.isnan(r["max_err"])]
     ordinary = [r for r in f64 if r["span_length"] <= 1920 and r["tilt_deg"] <= 85 and r["offset_texels"] <= 1e3]
     worst = max(f64, key=lambda r: r["max_err"], default=None)
-    undetected = sum(r["undetected"] for r in rows if r["undetected"] != "")
+    undetected = sum(r["undetected"] for r in rows if r["undetected"] is not None)
     return [
         f"- GPU kernels against their numpy twins, {len(checked)} method × configuration checks: largest difference "
         f"{_f(float(ulps))} ulp, {int(flags)} flag mismatches (0 and 0: bit for bit).",
@@ -241,165 +240,19 @@ def tieback_table(relief: list[dict]) -> list[str]:
               *(f"`{t}` {v}" for t in techniques for v in ("raw", "fract"))]
     body = []
     for m in mags:
-        row = [f"{m:g}", _first(relief, magnitude_uv=m)["input_spacing_texels"]]
+        row = [f"{m:g}", first_row(relief, magnitude_uv=m)["input_spacing_texels"]]
         for t in techniques:
             for v in ("raw", "shader_fract"):
-                r = _first(relief, technique=t, magnitude_uv=m, variant=v)
+                r = first_row(relief, technique=t, magnitude_uv=m, variant=v)
                 row.append(r["p99_err"] if r else "")
         body.append(row)
     return _table(header, body)
 
 
-# --- plots ------------------------------------------------------------------------------------------------------
+#: The report's title (harness.header).
+TITLE = "Perspective-correct texturing: speed against float error (Romanyuk & Dudnyk)"
 
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save(fig, path: Path) -> None:
-    with atomic_open(path) as f:
-        fig.savefig(f, format="png", dpi=110, bbox_inches="tight")
-
-
-def _style(name: str) -> dict:
-    if name == "hardware":
-        return {"color": "black", "linestyle": "-", "linewidth": 2.2, "marker": "s", "markersize": 4}
-    family = METHODS[name].family
-    return {"linestyle": {"paper": "-", "reference": ":", "mitigation": "--"}[family], "marker": "o", "markersize": 3}
-
-
-VALUE_LABELS = {"max_err": "max texture-coordinate error (texels)",
-                "max_err_px": "max error / the pixel's texel footprint (pixels)"}
-
-
-def plot_sweep(plt, rows, sweep: str, key: str, path: Path, xlabel: str, logx: bool, title: str,
-               values=("max_err",)) -> None:
-    groups = [("the paper's forms (float32)", PAPER_F32 + ["hardware"]),
-              ("subdivided and mitigations (float32)", ["incremental", *REFERENCE_F32, *MITIGATIONS])]
-    fig, axes = plt.subplots(len(values), 2, figsize=(13, 4.8 * len(values)), sharey="row", squeeze=False)
-    for line, value in zip(axes, values):
-        for ax, (label, methods) in zip(line, groups):
-            for m in methods:
-                pts = sorted((r[key], r[value]) for r in _select(rows, sweep=sweep, method=m, precision=_f32(m))
-                             if isinstance(r[value], float) and r[value] > 0)
-                if pts:
-                    ax.plot(*zip(*pts), label=m, **_style(m))
-            ax.set_yscale("log")
-            if logx:
-                ax.set_xscale("log")
-                if key == "span_length":  # label lengths people know (1080p and 4K rows), not powers of ten
-                    from matplotlib.ticker import NullFormatter
-
-                    lengths = {r[key] for r in _select(rows, sweep=sweep)}
-                    marks = sorted(lengths & {64, 256, 1024, 1920, 3840, 8192, 16384}) or sorted(lengths)
-                    ax.set_xticks(marks, [str(int(n)) for n in marks], fontsize=8)
-                    ax.xaxis.set_minor_formatter(NullFormatter())
-            ax.set_xlabel(xlabel)
-            ax.set_title(label)
-            ax.grid(True, which="both", alpha=0.3)
-            ax.legend(fontsize=7, ncol=2)
-        line[0].set_ylabel(VALUE_LABELS[value])
-    fig.suptitle(title)
-    _save(fig, path)
-    plt.close(fig)
-
-
-def plot_along(plt, along: list[dict], path: Path) -> None:
-    fig, ax = plt.subplots(figsize=(8, 4.8))
-    for m in ["incremental", "parallel_2", "parallel_8", "parallel_32", "two_ended", "direct", "kahan", "hardware"]:
-        pts = [((r["n_start"] + r["n_end"]) / 2, r["max_err"]) for r in along
-               if r["method"] == m and r["precision"] == _f32(m) and r["max_err"] > 0]
-        if pts:
-            ax.plot(*zip(*pts), label=m, **_style(m))
-    ax.set_yscale("log")
-    ax.set_xlabel("position along the span n (pixels)")
-    ax.set_ylabel("max error in the bin (texels)")
-    length = along[0]["span_length"] if along else 0
-    ax.set_title(f"Where the float32 error builds up along a {int(length)}-pixel span")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    _save(fig, path)
-    plt.close(fig)
-
-
-def plot_pareto(plt, rows, path: Path) -> None:
-    speed = _select(rows, sweep="speed")
-    if not speed:
-        return
-    w, h = speed[0]["span_length"], speed[0]["spans"]
-    here = [r for r in speed if (r["span_length"], r["spans"]) == (w, h)]
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5), sharey=True)
-    for ax, key, label in ((axes[0], "gpu_ratio", "GPU time × direct"), (axes[1], "cpu_ratio", "CPU (numpy) time × direct")):
-        for r in here:
-            if not isinstance(r[key], float) or not r["max_err"] > 0:
-                continue
-            style = _style(r["method"])
-            ax.scatter(r[key], r["max_err"], color=style.get("color"), marker=style["marker"], s=30)
-            ax.annotate(r["method"], (r[key], r["max_err"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel(label)
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].set_ylabel("max error (texels)")
-    fig.suptitle(f"Error against cost: {int(h)} spans of {int(w)} pixels, tilt {here[0]['tilt_deg']:g}°")
-    _save(fig, path)
-    plt.close(fig)
-
-
-def plot_heatmap(plt, heat: dict, path: Path) -> None:
-    from matplotlib.colors import LogNorm
-
-    ref = heat["reference"]
-    checker = (np.floor(ref.u / 32) + np.floor(ref.v / 32)) % 2
-    picture = np.where(ref.valid, 0.35 + 0.5 * checker, 0.05)
-    errors = [heat["incremental"], heat["direct"]]
-    top = max(float(np.nanmax(e)) for e in errors)
-    norm = LogNorm(vmin=max(top * 1e-5, 1e-6), vmax=top)
-    fig, axes = plt.subplots(3, 1, figsize=(9, 11), layout="constrained")
-    axes[0].imshow(picture, cmap="gray", vmin=0, vmax=1, interpolation="nearest")
-    axes[0].set_title("the quad: a 32-texel checker at the float64 uv, unfiltered (black: past the horizon)")
-    for ax, err, name in zip(axes[1:], errors, ("incremental", "direct")):
-        image = ax.imshow(err, cmap="inferno", norm=norm, interpolation="nearest")
-        ax.set_title(f"{name}, float32: texel error (max {np.nanmax(err):.3g}); each row is a span, left to right")
-    fig.colorbar(image, ax=list(axes), label="texels (black: below the scale or not compared)", shrink=0.6)
-    for ax in axes:
-        ax.set_xticks([])
-        ax.set_yticks([])
-    s = heat["setup"]
-    fig.suptitle(f"Float32 drift on a long grazing quad: {s.span_length}×{s.rows}, tilt {s.tilt:g}° at the far end")
-    _save(fig, path)
-    plt.close(fig)
-
-
-def plot_tieback(plt, relief: list[dict], path: Path) -> None:
-    if not relief:
-        return
-    fig, ax = plt.subplots(figsize=(8, 5))
-    mags = sorted({r["magnitude_uv"] for r in relief if r["magnitude_uv"] > 0})
-    for t in dict.fromkeys(r["technique"] for r in relief):
-        for variant, style in (("raw", "-"), ("shader_fract", "--")):
-            pts = [(r["magnitude_uv"], r["p99_err"]) for r in relief
-                   if r["technique"] == t and r["variant"] == variant and r["magnitude_uv"] > 0]
-            ax.plot(*zip(*sorted(pts)), style, marker="o", markersize=3, label=f"{t} ({variant})")
-    spacing = [_first(relief, magnitude_uv=m)["input_spacing_texels"] for m in mags]
-    ax.plot(mags, spacing, ":", color="black", label="float32 spacing of the uv")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("texture coordinate magnitude (UV units; the texture spans 1)")
-    ax.set_ylabel("p99 hit-uv error (texels)")
-    ax.set_title(f"Relief techniques at large uv ({int(relief[0]['texels'])}² map, {relief[0]['angle_deg']:g}°)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-    _save(fig, path)
-    plt.close(fig)
-
-
+#: The plots (plots.py draws them), file name -> what it shows.
 PLOTS = {
     "error_vs_span_length.png": "max error against span length (tilt 80°)",
     "error_along_span.png": "where along the span the error builds up",
@@ -411,29 +264,11 @@ PLOTS = {
 }
 
 
-def write_outputs(out: Path, rows: list[dict], along: list[dict], relief: list[dict], heat: dict, meta: dict) -> None:
-    plt = _pyplot()
-    plot_sweep(plt, rows, "span_length", "span_length", out / "error_vs_span_length.png", "span length (pixels)",
-               True, "Float32 error against span length")
-    plot_along(plt, along, out / "error_along_span.png")
-    plot_sweep(plt, rows, "tilt", "tilt_deg", out / "error_vs_tilt.png", "angle at the span's far end (degrees)",
-               False, "Float32 error against tilt: in texels, and in pixels of the footprint there",
-               values=("max_err", "max_err_px"))
-    plot_sweep(plt, rows, "magnitude", "coord_max_texels", out / "error_vs_magnitude.png",
-               "largest texture coordinate in the frame (texels)", True, "Float32 error against coordinate magnitude")
-    plot_pareto(plt, rows, out / "pareto.png")
-    plot_heatmap(plt, heat, out / "drift_heatmap.png")
-    plot_tieback(plt, relief, out / "tieback.png")
-    write_bytes(out / "report.md", report_text(rows, relief, meta).encode("utf-8"))
-
-
-def report_text(rows: list[dict], relief: list[dict], meta: dict) -> str:
+def report_text(rows: list[dict], relief: list[dict], meta: dict, plotted: bool) -> str:
     suite = meta["suite"]
     lines = [
-        "# Perspective-correct texturing: speed against float error (seed 001)",
-        "",
-        f"Command: `{meta['command'] or 'wgpuviewer perspective'}` · suite `{suite.name}` · {meta['date']}",
-        f"Adapter: **{meta['adapter']}** · Python {meta['python']}, numpy {meta['numpy']} · {meta['platform']}",
+        *meta["header"].lines(),
+        f"- Python {meta['python']}, numpy {meta['numpy']} · {meta['platform']}",
         "",
     ]
     if meta["software"]:
@@ -482,7 +317,7 @@ def report_text(rows: list[dict], relief: list[dict], meta: dict) -> str:
         "## Speed and operation counts",
         "",
         "GPU: median time per pass over the run's rounds, every method's pass taking turns with the others "
-        f"(timer `{_select(rows, sweep='speed')[0]['timer'] if _select(rows, sweep='speed') else '–'}`; "
+        f"(timer `{select_rows(rows, sweep='speed')[0]['timer'] if select_rows(rows, sweep='speed') else '–'}`; "
         "`wall-net` is submit to completion minus an empty pass, `docs/perspective.md` says why); ± is half the "
         "interquartile range of the single passes over their median. CPU: median wall time of the numpy form. "
         "Operation counts per texel (u and v together) come from running the numpy code with counting "
@@ -498,7 +333,7 @@ def report_text(rows: list[dict], relief: list[dict], meta: dict) -> str:
         "",
         "## Plots",
         "",
-        *(f"- `{name}`: {text}\n\n  ![{name}]({name})" for name, text in PLOTS.items()),
+        *((f"- `{name}`: {text}\n\n  ![{name}]({name})" for name, text in PLOTS.items()) if plotted else [MISSING]),
         "",
     ]
     return "\n".join(lines)

@@ -16,8 +16,6 @@ in every configuration (``gpu_max_ulp``, ``gpu_flag_mismatch``).
 
 from __future__ import annotations
 
-import csv
-import datetime
 import platform
 import sys
 import time
@@ -26,8 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
-from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.io import write_csv
+from wgpuviewer.core.io import output_dir, write_bytes
+from wgpuviewer.harness import suite as harness_suite
+from wgpuviewer.harness.header import Clock
+from wgpuviewer.harness.table import Column, Table
 
 from . import tieback
 from .geometry import Quad, Reference, Setup, build, reference
@@ -42,8 +42,7 @@ DIRECT = "direct"
 
 
 @dataclass(frozen=True)
-class Suite:
-    name: str
+class Suite(harness_suite.Suite):
     span_lengths: tuple[int, ...]
     tilts: tuple[float, ...]
     offsets: tuple[float, ...]
@@ -60,31 +59,53 @@ class Suite:
     relief_texels: int
 
 
-SUITES = {
-    "smoke": Suite("smoke", (256, 1920, 3840, 8192), (45.0, 80.0, 89.9, 95.0), (0.0, 1e4, 1e6), rows=4, instances=2,
+SUITES = harness_suite.suites(
+    Suite("smoke", (256, 1920, 3840, 8192), (45.0, 80.0, 89.9, 95.0), (0.0, 1e4, 1e6), rows=4, instances=2,
                    sweep_span=1920, speed_frames=((1920, 128), (8192, 16)), gpu_repeats=7, cpu_repeats=2,
                    heatmap_frame=(480, 270), relief_techniques=("pom", "maxmip"),
                    relief_magnitudes=(0.0, 1e3, 1e5, 1e7), relief_rays=256, relief_texels=64),
     # Powers of two and their neighbours, and lengths between: the drift depends on the increment's low bits.
-    "full": Suite("full", (64, 128, 256, 512, 1000, 1024, 1366, 1920, 2048, 2560, 3000, 3840, 4095, 4096, 5000,
+    Suite("full", (64, 128, 256, 512, 1000, 1024, 1366, 1920, 2048, 2560, 3000, 3840, 4095, 4096, 5000,
                            6000, 7680, 8192, 10000, 12000, 16383, 16384),
                   (30.0, 45.0, 60.0, 70.0, 75.0, 80.0, 85.0, 87.0, 89.0, 89.5, 89.9, 90.0, 95.0),
                   (0.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7), rows=16, instances=8, sweep_span=3840,
                   speed_frames=((3840, 2160), (8192, 64)), gpu_repeats=15, cpu_repeats=3, heatmap_frame=(1920, 1080),
                   relief_techniques=("pom", "relief", "maxmip", "cone", "distance"),
                   relief_magnitudes=(0.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7), relief_rays=4096, relief_texels=128),
-}
-
-COLUMNS = (
-    "suite", "sweep", "method", "family", "precision", "span_length", "spans", "tilt_deg", "offset_texels",
-    "coord_max_texels", "max_err", "p99_err", "mean_err", "max_err_px", "flagged_fraction", "undetected",
-    "gpu_max_ulp", "gpu_flag_mismatch", "gpu_ms", "gpu_ratio", "gpu_spread", "cpu_ms", "cpu_ratio", "adds_per_texel",
-    "muls_per_texel", "divs_per_texel", "guards_per_texel", "int_adds_per_texel", "ops_per_span", "paper_adds",
-    "paper_muls", "paper_divs", "timer", "adapter",
 )
-ALONG_COLUMNS = ("method", "precision", "span_length", "n_start", "n_end", "max_err", "mean_err")
-TIEBACK_COLUMNS = ("technique", "magnitude_uv", "variant", "texels", "rays", "angle_deg", "input_spacing_texels",
-                   "max_err", "p99_err", "mean_err", "capped_fraction")
+
+#: results.csv: one row per sweep configuration x method x precision. A cell that does not apply to the row (the
+#: GPU time outside the speed sweep, the kernel check of a method's second precision) is empty.
+TABLE = Table("perspective results", (
+    Column("suite", str), Column("sweep", str), Column("method", str), Column("family", str),
+    Column("precision", str), Column("span_length", int, "pixels"), Column("spans", int),
+    Column("tilt_deg", float, "degrees at the span's far end"), Column("offset_texels", float, "texels"),
+    Column("coord_max_texels", float, "texels"), Column("max_err", float, "texels"), Column("p99_err", float, "texels"),
+    Column("mean_err", float, "texels"), Column("max_err_px", float, "pixels"),
+    Column("flagged_fraction", float, "of the pixels"), Column("undetected", int, "pixels"),
+    Column("gpu_max_ulp", int, "float32 ulp"), Column("gpu_flag_mismatch", int, "pixels"),
+    Column("gpu_ms", float, "ms, median"), Column("gpu_ratio", float, "x direct"),
+    Column("gpu_spread", float, "interquartile range / median"), Column("cpu_ms", float, "ms, median"),
+    Column("cpu_ratio", float, "x direct"), *(Column(f"{kind}_per_texel", float, "operations")
+                                                for kind in ("adds", "muls", "divs", "guards", "int_adds")),
+    Column("ops_per_span", float, "operations"), Column("paper_adds", int), Column("paper_muls", int),
+    Column("paper_divs", int), Column("timer", str), Column("adapter", str),
+))
+COLUMNS = TABLE.names
+#: along_span.csv: the error in bins along one long span.
+ALONG_TABLE = Table("perspective along-span errors", (
+    Column("method", str), Column("precision", str), Column("span_length", int, "pixels"),
+    Column("n_start", int, "pixels"), Column("n_end", int, "pixels"), Column("max_err", float, "texels"),
+    Column("mean_err", float, "texels"),
+))
+#: tieback.csv: relief techniques' hit uv at large texture coordinates (tieback.py).
+TIEBACK_TABLE = Table("perspective relief tie-back", (
+    Column("technique", str), Column("magnitude_uv", float, "UV units"), Column("variant", str),
+    Column("texels", int), Column("rays", int), Column("angle_deg", float, "degrees"),
+    Column("input_spacing_texels", float, "texels"), Column("max_err", float, "texels"),
+    Column("p99_err", float, "texels"), Column("mean_err", float, "texels"),
+    Column("capped_fraction", float, "of the rays"),
+))
 
 
 def instances(setup: Setup, count: int) -> list[Setup]:
@@ -154,7 +175,7 @@ class Study:
 
     def base(self, sweep: str, method: str, precision: str, setup: Setup, spans: int) -> dict:
         m = METHODS.get(method)
-        row = dict.fromkeys(COLUMNS, "")
+        row = TABLE.blank()
         row.update({
             "suite": self.suite.name, "sweep": sweep, "method": method,
             "family": m.family if m else HARDWARE, "precision": precision, "span_length": setup.span_length,
@@ -273,23 +294,17 @@ class Study:
         return out
 
 
-def run(suite_name: str, out: Path, backend: str | None = None, progress: bool = True, command: str = "") -> list[dict]:
+def run(suite_name: str, out: Path, backend: str | None = None, progress: bool = True,
+        command: str = "wgpuviewer perspective") -> list[dict]:
     """Run the study; write ``out``/results.csv, along_span.csv, tieback.csv, report.md and the plots."""
     from tqdm import tqdm
 
-    from .report import write_outputs
+    from .plots import write_plots
+    from .report import TITLE, report_text
 
-    if suite_name not in SUITES:
-        raise UserError(f"--suite {suite_name!r}: unknown; expected one of {', '.join(SUITES)}")
-    suite = SUITES[suite_name]
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out {out}: exists and is not a folder; choose a folder")
-    try:  # before minutes of work, not after
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise UserError(f"--out {out}: cannot create the folder ({e.strerror or e}); choose another") from None
-    started = datetime.datetime.now(datetime.UTC)
+    suite = harness_suite.pick(SUITES, suite_name)
+    out = output_dir(out, "--out")  # before minutes of work, not after
+    clock = Clock()
     study = Study(suite, backend)
     configs = ([("span_length", Setup(span_length=n, rows=suite.rows, tilt=SWEEP_TILT)) for n in suite.span_lengths]
                + [("tilt", Setup(span_length=suite.sweep_span, rows=suite.rows, tilt=t)) for t in suite.tilts]
@@ -313,26 +328,14 @@ def run(suite_name: str, out: Path, backend: str | None = None, progress: bool =
         bar.set_postfix_str("relief tie-back")
         relief = tieback.measure(suite.relief_techniques, suite.relief_magnitudes, suite.relief_rays,
                                  suite.relief_texels, backend, progress=bar.update)
-    finished = datetime.datetime.now(datetime.UTC)
-    write_csv(out / "results.csv", COLUMNS, study.rows)
-    write_csv(out / "along_span.csv", ALONG_COLUMNS, study.along)
-    write_csv(out / "tieback.csv", TIEBACK_COLUMNS, relief)
+    TABLE.write(out / "results.csv", study.rows)
+    ALONG_TABLE.write(out / "along_span.csv", study.along)
+    TIEBACK_TABLE.write(out / "tieback.csv", relief)
     meta = {
-        "suite": suite, "adapter": study.gpu.summary, "software": study.gpu.software, "command": command,
-        "date": f"{started:%Y-%m-%d %H:%M} UTC (took {(finished - started).total_seconds():.0f} s)",
+        "header": clock.header(TITLE, command, study.gpu.summary, suite.name),
+        "suite": suite, "software": study.gpu.software,
         "python": platform.python_version(), "numpy": np.__version__, "platform": platform.platform(),
     }
-    write_outputs(out, study.rows, study.along, relief, heat, meta)
+    plotted = write_plots(out, study.rows, study.along, relief, heat)
+    write_bytes(out / "report.md", report_text(study.rows, relief, meta, plotted).encode("utf-8"))
     return study.rows
-
-
-def read_csv(path: Path) -> list[dict]:
-    """A CSV written here, numbers parsed (empty cells stay "")."""
-    def parse(text: str):
-        try:
-            return float(text)
-        except ValueError:
-            return text
-
-    with open(path, newline="", encoding="utf-8") as f:
-        return [{k: parse(v) for k, v in row.items()} for row in csv.DictReader(f)]

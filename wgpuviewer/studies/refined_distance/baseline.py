@@ -1,5 +1,5 @@
-"""The plain distance map as it was before issue 12 (maptools-2), kept here only as the baseline the study measures
-the new maps against ("fewer fetches than today's plain map"): per voxel the exact distance from the voxel *centre*
+"""The plain distance map of maptools version 2 (before the box-exact map), kept here only as the baseline the study
+measures the other maps against: per voxel the exact distance from the voxel *centre*
 to the cell-min solid S' (each bilinear cell x [least corner depth, inf)), minus half the voxel diagonal and the
 0.001 store margin. Never larger than the box-exact value on the same solid (dist(box, S') >= dist(centre, S') - h;
 tests/studies checks it), so it is as safe, and looser.

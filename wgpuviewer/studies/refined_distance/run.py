@@ -6,7 +6,7 @@ build time and memory of each map. Variants no technique binds are traced by the
 
 from __future__ import annotations
 
-import csv
+import math
 import tempfile
 import time
 from dataclasses import dataclass
@@ -17,6 +17,10 @@ import numpy as np
 from maptools.cache import cached_generate
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import write_bytes
+from wgpuviewer.harness import suite as harness_suite
+from wgpuviewer.harness.header import Clock, Header
+from wgpuviewer.harness.plots import MISSING, pyplot, save_png
+from wgpuviewer.harness.table import Column, Table
 from wgpuviewer.relief.accuracy import simd_tile_cost
 from wgpuviewer.relief.maps import DISTANCE_SLICES
 from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
@@ -62,21 +66,30 @@ PRODUCT = VARIANTS[-1].name
 
 
 @dataclass(frozen=True)
-class Suite:
+class Suite(harness_suite.Suite):
     heightmaps: tuple[str, ...]
     angles: tuple[float, ...]
     resolution: tuple[int, int]
     builtin_size: int
 
 
-SUITES = {
-    "smoke": Suite(("bricks", "wall"), (45.0, 80.0), (32, 16), 32),
-    "full": Suite(("brick", "grass", "gravel", "bricks", "bumps", "ridges", "wall"), (0.0, 30.0, 45.0, 60.0, 75.0, 80.0),
-                  (256, 144), 256),
-}
+SUITES = harness_suite.suites(
+    Suite("smoke", ("bricks", "wall"), (45.0, 80.0), (32, 16), 32),
+    Suite("full", ("brick", "grass", "gravel", "bricks", "bumps", "ridges", "wall"),
+          (0.0, 30.0, 45.0, 60.0, 75.0, 80.0), (256, 144), 256),
+)
 
-COLUMNS = ("heightmap", "size", "angle", "variant", "tracer", "fetches_mean", "fetches_simd", "capped", "build_s",
-           "memory_mib")
+#: results.csv: one row per height map x variant x angle x tracer (the numpy twin; the GPU renderer where a
+#: technique renders the variant).
+TABLE = Table("refined-distance results", (
+    Column("heightmap", str), Column("size", str, "texels, WxH"), Column("angle", float, "degrees"),
+    Column("variant", str), Column("tracer", str), Column("fetches_mean", float, "fetches per pixel"),
+    Column("fetches_simd", float, "fetches per SIMD tile of 8x4 pixels"), Column("capped", float, "of the pixels"),
+    Column("build_s", float, "seconds, cache included"), Column("memory_mib", float, "MiB"),
+))
+
+#: The report's title (harness.header).
+TITLE = "Distance-map variants: fetches per pixel (mean / SIMD-tile 8x4)"
 
 
 def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[np.ndarray, float]:
@@ -90,7 +103,7 @@ def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[n
 
 
 def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str | None = None,
-        progress: bool = True) -> list[dict]:
+        progress: bool = True, command: str = "wgpuviewer refined-distance") -> list[dict]:
     """Measure every variant of ``SUITES[suite_name]``; write ``out``/results.csv and report.md; return the rows."""
     from tqdm import tqdm
 
@@ -99,9 +112,8 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
     from wgpuviewer.core.gpu import get_gpu
     from wgpuviewer.relief.renderer import DrawConfig, Renderer
 
-    if suite_name not in SUITES:
-        raise UserError(f"--suite {suite_name!r}: unknown; expected one of {', '.join(SUITES)}")
-    suite = SUITES[suite_name]
+    suite = harness_suite.pick(SUITES, suite_name)
+    clock = Clock()
     maps = tuple(heightmaps or suite.heightmaps)
     if heightmaps is None and not skimage_available():
         maps = tuple(m for m in maps if m not in REAL_MAPS)
@@ -133,7 +145,7 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
                         rows.append(_row(heightmap, view, variant, f"GPU ({gpu.summary})", fetches, image.covered,
                                          raw[image.covered] < 0, seconds, volumes))
                 bar.update()
-            _write(out, rows)
+            _write(out, rows, clock.header(TITLE, command, gpu.summary, suite.name))
     return rows
 
 
@@ -144,11 +156,11 @@ def _row(heightmap, view, variant, tracer, fetches, covered, capped, seconds, vo
             "capped": float(np.mean(capped)), "build_s": seconds, "memory_mib": volumes.nbytes / 2**20}
 
 
-def _write(out: Path, rows: list[dict]) -> None:
-    text = _csv(rows)
-    write_bytes(out / "results.csv", text.encode())
-    write_bytes(out / "report.md", report(rows).encode())
-    plot(rows, out / PLOT)
+def _write(out: Path, rows: list[dict], header: Header) -> None:
+    """results.csv, the plot and report.md of the rows so far (rewritten after each height map)."""
+    TABLE.write(out / "results.csv", rows)
+    plotted = plot(rows, out / PLOT)
+    write_bytes(out / "report.md", report(rows, header, plotted).encode())
 
 
 #: The picture of the report: fetches per pixel against the view angle, one panel per height map.
@@ -158,24 +170,22 @@ PLOT = "fetches_vs_angle.png"
 def plot(rows: list[dict], path: Path) -> bool:
     """Mean fetches per pixel (solid) and SIMD-tile fetches (dotted) against the view angle, one line per variant
     and one panel per height map (numpy-twin rows). False when matplotlib is missing (the tables still stand)."""
-    try:
-        import matplotlib
+    with pyplot() as plt:
+        if plt is None:
+            return False
+        _draw(plt, rows, path)
+    return True
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return False
-    import io
-    import math
 
+def _draw(plt, rows: list[dict], path: Path) -> None:
     twins = [r for r in rows if r["tracer"] == "numpy twin"]
     maps = list(dict.fromkeys(r["heightmap"] for r in twins))
     cols = min(4, len(maps)) or 1
-    fig, axes = plt.subplots(math.ceil(len(maps) / cols) or 1, cols, figsize=(3.6 * cols, 3.0 * math.ceil(len(maps) / cols)),
-                             squeeze=False)
+    panel_rows = math.ceil(len(maps) / cols) or 1
+    fig, axes = plt.subplots(panel_rows, cols, figsize=(3.6 * cols, 3.0 * panel_rows), squeeze=False)
     for ax, name in zip(axes.ravel(), maps):
         for i, variant in enumerate(v.name for v in VARIANTS):
-            mine = sorted((float(r["angle"]), float(r["fetches_mean"]), float(r["fetches_simd"]))
+            mine = sorted((r["angle"], r["fetches_mean"], r["fetches_simd"])
                           for r in twins if r["heightmap"] == name and r["variant"] == variant)
             if not mine:
                 continue
@@ -187,28 +197,14 @@ def plot(rows: list[dict], path: Path) -> bool:
         ax.set_xlabel("view angle at the frame centre (deg)", fontsize=7)
         ax.set_ylabel("fetches per pixel", fontsize=7)
         ax.tick_params(labelsize=7)
-        ax.grid(alpha=0.3)
+        ax.grid()
     for ax in axes.ravel()[len(maps):]:
         ax.axis("off")
     handles, labels = axes.ravel()[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=min(4, len(labels)), fontsize=7, frameon=False)
     fig.suptitle("Distance-map variants: every fetch to the exact hit (solid: mean, dotted: SIMD-tile 8x4)", fontsize=9)
     fig.tight_layout(rect=(0, 0.08, 1, 0.96))
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    write_bytes(path, buf.getvalue())
-    return True
-
-
-def _csv(rows: list[dict]) -> str:
-    import io
-
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=COLUMNS)
-    writer.writeheader()
-    writer.writerows(rows)
-    return buf.getvalue()
+    save_png(fig, path, tight=False)
 
 
 #: The report's change columns: (label, variant, against which variant).
@@ -224,13 +220,13 @@ def _change(by: dict, variant: str, base: str) -> str:
             f"{100 * (a['fetches_simd'] / b['fetches_simd'] - 1):+.0f} %")
 
 
-def report(rows: list[dict]) -> str:
+def report(rows: list[dict], header: Header, plotted: bool) -> str:
     """Markdown: per height map, fetches per pixel mean / SIMD-tile by angle (rows) and variant (columns), the changes
-    of the new plain map and of the product's refined map against the map before issue 12 and against each other,
+    of the box-exact plain map and of the product's refined map against the maptools-2 map and against each other,
     build times and memory."""
-    lines = ["# Distance-map variants: fetches per pixel (mean / SIMD-tile 8x4)", "",
+    lines = [*header.lines(), "",
              "Every fetch to the final hit (volume fetches and exact-cell gathers), the same tracer for every map. "
-             f"Changes: mean / SIMD-tile. Plot: [{PLOT}]({PLOT}).", ""]
+             "Changes: mean / SIMD-tile. " + (f"Plot: [{PLOT}]({PLOT})." if plotted else MISSING), ""]
     variants = [v.name for v in VARIANTS]
     for name in dict.fromkeys(r["heightmap"] for r in rows):
         mine = [r for r in rows if r["heightmap"] == name and r["tracer"] == "numpy twin"]
