@@ -164,9 +164,12 @@ def cmd_accuracy(args) -> int:
         raise UserError(f"--height-scale {args.height_scale}: expected a relief depth in (0, 1] UV units")
     if args.texels < 1:
         raise UserError(f"--texels {args.texels}: expected at least 1 texel")
+    if args.doc:
+        refuse_directory(args.doc, "accuracy.md")
     from tqdm import tqdm
 
-    from wgpuviewer.relief.accuracy import DEFAULT_ANGLES, DEFAULT_SETTINGS, table
+    from wgpuviewer.core.io import write_bytes
+    from wgpuviewer.relief.accuracy import DEFAULT_ANGLES, DEFAULT_SETTINGS, markdown_report, run, table
 
     from .textures import BUILTINS, builtin_height
 
@@ -179,7 +182,17 @@ def cmd_accuracy(args) -> int:
 
     gpu = get_gpu(args.backend)
     with tqdm(total=total, desc="probe vs reference", file=sys.stderr, leave=False) as bar:
-        text = table(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend, progress=bar.update)
+        if args.doc:
+            measured = run(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend,
+                           progress=bar.update)
+        else:
+            text = table(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend,
+                         progress=bar.update)
+    if args.doc:
+        report = markdown_report(measured, command=args.command_line, adapter=gpu.summary)
+        write_bytes(args.doc, report.encode("utf-8"))
+        print(args.doc)
+        return 0
     print(f"Adapter: {gpu.summary}; height_scale {args.height_scale}; {args.rays} random rays per row; "
           f"{args.texels}x{args.texels} maps; errors over rays that were not capped.\n")
     print(text)
@@ -259,6 +272,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
     accuracy.add_argument("--rays", type=int, default=4096, help="random rays per row")
     accuracy.add_argument("--height-scale", type=float, default=0.05, help="relief depth in UV units")
     add_backend_option(accuracy)
+    accuracy.add_argument("--doc", metavar="PATH",
+                          help="write the markdown report (docs/accuracy.md) to PATH instead of printing the table")
     accuracy.set_defaults(func=cmd_accuracy)
 
     for study in measurement_commands():
