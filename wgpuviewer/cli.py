@@ -12,6 +12,7 @@ from pathlib import Path
 from wgpuviewer.core.cli import (
     OneLineParser,
     add_backend_option,
+    command_line,
     parse_size,
     prepare_process,
     run_command,
@@ -287,8 +288,6 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
 
 def main(argv: list[str] | None = None) -> int:
     """Exit codes (wgpuviewer.core.cli): 0 ok, 1 a check failed, 2 a user error, 3 an internal error."""
-    from wgpuviewer.harness.study import command_line
-
     prepare_process("wgpuviewer")  # before any GPU driver loads
     given = list(sys.argv[1:] if argv is None else argv)
 
@@ -296,7 +295,7 @@ def main(argv: list[str] | None = None) -> int:
         parser, commands = build_parser()
         words = given if given and (given[0] in commands or given[0] in ("-h", "--help")) else ["view", *given]
         args = parser.parse_args(words)  # `wgpuviewer [SCENE] [--technique ...]` means view
-        args.command_line = command_line(words)  # what the reports record
+        args.command_line = command_line("wgpuviewer", words)  # what the reports record
         return args.func(args)
 
     try:

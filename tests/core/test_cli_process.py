@@ -189,3 +189,8 @@ def test_opencv_warnings_are_silenced(tmp_path):
                                 cwd=tmp_path)
         assert result.stdout.strip() == "read", result.stderr
         assert "WARN" not in result.stderr, (order, result.stderr)
+
+
+def test_the_command_line_is_quoted_as_a_shell_would_need():
+    assert core_cli.command_line("wgpuviewer", ["bench", "--out", "my runs/a", "--suite", "smoke"]) == \
+        "wgpuviewer bench --out 'my runs/a' --suite smoke"

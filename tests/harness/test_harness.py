@@ -12,7 +12,7 @@ import pytest
 
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.harness.header import Clock, Header
-from wgpuviewer.harness.study import Study, command_line, discover
+from wgpuviewer.harness.study import Study, discover
 from wgpuviewer.harness.suite import Suite, pick, suites
 from wgpuviewer.harness.table import Column, Table
 
@@ -119,11 +119,6 @@ def test_suites_are_exactly_smoke_and_full():
     for wrong in ((Suite("smoke"),), (Suite("smoke"), Suite("full"), Suite("full")), (Suite("smoke"), Suite("big"))):
         with pytest.raises(ValueError):
             suites(*wrong)
-
-
-def test_command_line_quotes_what_a_shell_would_need():
-    assert command_line(["bench", "--out", "my runs/a", "--suite", "smoke"]) == \
-        "wgpuviewer bench --out 'my runs/a' --suite smoke"
 
 
 def _package(root, name: str, studies: dict[str, str]) -> None:

@@ -16,6 +16,7 @@ import argparse
 import contextlib
 import logging
 import os
+import shlex
 import stat
 import sys
 import tempfile
@@ -177,10 +178,15 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog.split()[0]}: error: {message}; see {self.prog} --help\n")
 
 
+def command_line(prog: str, argv: list[str]) -> str:
+    """The command line ``prog`` with ``argv`` as a shell would take it back (reports and tracebacks record it)."""
+    return shlex.join([prog, *argv])
+
+
 def save_traceback(prog: str, error: BaseException) -> Path | None:
     """The traceback of ``error`` in a new file in the temp dir; None if it cannot be written."""
     text = "".join(traceback.format_exception(error))
-    header = f"{prog} {' '.join(sys.argv[1:])}\n{time.strftime('%Y-%m-%d %H:%M:%S')}, Python {sys.version.split()[0]}\n\n"
+    header = f"{command_line(prog, sys.argv[1:])}\n{time.strftime('%Y-%m-%d %H:%M:%S')}, Python {sys.version.split()[0]}\n\n"
     try:
         fd, name = tempfile.mkstemp(prefix=f"{prog}-traceback-", suffix=".txt")
         with os.fdopen(fd, "w", encoding="utf-8") as f:

@@ -1,6 +1,7 @@
 """A study as a ``wgpuviewer`` subcommand: the ``Study`` protocol every study folder exposes as ``STUDY`` (in its
 ``__init__``), its discovery (every package under ``wgpuviewer.studies``), its registration on the command line
-with the options every measuring command shares, and the command line string its report records.
+with the options every measuring command shares (the CLI puts the command line, ``core.cli.command_line``, on
+``args.command_line`` for the report's header).
 
 A study's ``__init__`` stays light (no GPU, no heavy imports): the command line imports every study to build
 its parser; ``run`` imports the measuring code when the command runs.
@@ -11,14 +12,12 @@ from __future__ import annotations
 import argparse
 import importlib
 import pkgutil
-import shlex
 from typing import Protocol, runtime_checkable
 
 from wgpuviewer.core.cli import add_backend_option
 
 from .suite import NAMES
 
-PROG = "wgpuviewer"
 STUDIES_PACKAGE = "wgpuviewer.studies"
 
 
@@ -63,8 +62,3 @@ def add_measurement_options(parser, out_help: str, suite_help: str) -> None:
     parser.add_argument("--suite", choices=NAMES, default="full", help=suite_help)
     add_backend_option(parser)
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
-
-
-def command_line(argv: list[str]) -> str:
-    """The command line of ``argv`` (the arguments after the program name) as a shell would take it back."""
-    return shlex.join([PROG, *argv])

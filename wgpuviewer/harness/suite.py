@@ -15,10 +15,6 @@ NAMES = ("smoke", "full")
 class Suite:
     name: str  # one of NAMES
 
-    @property
-    def smoke(self) -> bool:
-        return self.name == "smoke"
-
 
 def suites(*items: Suite) -> dict[str, Suite]:
     """The suites by name; exactly one of each of ``NAMES``."""

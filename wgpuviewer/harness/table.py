@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -136,7 +135,3 @@ class Table:
 def _a(kind: type) -> str:
     return {str: "text", int: "a whole number", float: "a number", bool: "True or False"}[kind]
 
-
-def finite(value) -> bool:
-    """Whether ``value`` is a number that is not NaN or infinite (None and text are not)."""
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)

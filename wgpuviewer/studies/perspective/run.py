@@ -158,7 +158,7 @@ class Pooled:
         }
 
 
-class Study:
+class Measurements:
     """One run's measurements: the device and kernels, the rows so far, the per-method operation counts."""
 
     def __init__(self, suite: Suite, backend: str | None):
@@ -305,7 +305,7 @@ def run(suite_name: str, out: Path, backend: str | None = None, progress: bool =
     suite = harness_suite.pick(SUITES, suite_name)
     out = output_dir(out, "--out")  # before minutes of work, not after
     clock = Clock()
-    study = Study(suite, backend)
+    study = Measurements(suite, backend)
     configs = ([("span_length", Setup(span_length=n, rows=suite.rows, tilt=SWEEP_TILT)) for n in suite.span_lengths]
                + [("tilt", Setup(span_length=suite.sweep_span, rows=suite.rows, tilt=t)) for t in suite.tilts]
                + [("magnitude", Setup(span_length=suite.sweep_span, rows=suite.rows, tilt=SWEEP_TILT, offset=o))
