@@ -4,7 +4,6 @@ the CLI, and the smoke suite end to end (what CI runs)."""
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +15,7 @@ from wgpuviewer.relief.reference import exact_hit, uv_error_texels
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.studies.filtering import supersample as ss
 from wgpuviewer.studies.filtering.run import psnr
-from wgpuviewer.studies.filtering.suites import Config
+from wgpuviewer.studies.filtering.suites import TABLE, Config
 from wgpuviewer.studies.filtering.views import HEIGHT_SCALE, TEXTURE_SIZE, Case, depth_map, make_view
 
 SIZE = (32, 24)
@@ -180,25 +179,26 @@ def test_render_with_a_filter(tmp_path, adapter):
 def test_smoke_suite_end_to_end(tmp_path, adapter):
     out = tmp_path / "smoke"
     assert main(["filtering", "--out", str(out), "--suite", "smoke", "--quiet"]) == 0
-    with open(out / "results.csv") as f:
-        rows = list(csv.DictReader(f))
+    rows = TABLE.read(out / "results.csv")
     assert {"filter", "derivatives", "psnr", "ssim", "psnr_gauss", "psnr_occluded", "time_ratio",
             "texels_per_pixel", "capped_share"} <= set(rows[0])
     labels = {r["label"] for r in rows}
     assert {"trilinear (uv)", "aniso 16 (uv)", "ewa (displaced)", "ewa_vis (displaced)",
             "ewa_vis_rows (displaced)"} <= labels
     for r in rows:
-        assert np.isfinite(float(r["psnr"])) and 0.0 < float(r["ssim"]) <= 1.0 and float(r["time_ratio"]) > 0
+        assert np.isfinite(r["psnr"]) and 0.0 < r["ssim"] <= 1.0 and r["time_ratio"] > 0 and r["pixels"] > 0
         if r["label"] == "trilinear (uv)":
-            assert float(r["time_ratio"]) == 1.0
+            assert r["time_ratio"] == 1.0
     by = {(r["case"], r["label"]): r for r in rows}
     flat = [c for c, label in by if c.startswith("flat0") and label == "ewa (displaced)"]
     for case in flat:  # nothing is hidden on a flat relief: visibility changes nothing
         assert by[case, "ewa_vis (displaced)"]["psnr"] == by[case, "ewa (displaced)"]["psnr"]
-        assert float(by[case, "ewa_vis (displaced)"]["hidden_per_pixel"]) == 0.0
-    occluding = [r for r in rows if r["occluding"] == "True" and r["label"] == "ewa_vis (displaced)"]
-    assert occluding and all(float(r["hidden_per_pixel"]) > 0 and float(r["occluded_share"]) > 0 for r in occluding)
+        assert by[case, "ewa_vis (displaced)"]["hidden_per_pixel"] == 0.0
+    occluding = [r for r in rows if r["occluding"] is True and r["label"] == "ewa_vis (displaced)"]
+    assert occluding and all(r["hidden_per_pixel"] > 0 and r["occluded_share"] > 0 for r in occluding)
     report = (out / "report.md").read_text()
+    assert report.startswith("# Texture filtering on relief surfaces (Romanyuk & Dudnyk 2017)\n\n- command: "
+                             f"`wgpuviewer filtering --out {out} --suite smoke --quiet`\n- adapter: **{rows[0]['adapter']}**")
     assert "## The answer" in report and "pareto.png" in report and "crops_" in report
     assert (out / "pareto.png").stat().st_size > 10_000
     crops = list(out.glob("crops_*.png"))

@@ -86,6 +86,8 @@ def test_the_speed_rows_compare_every_method_to_direct_in_the_same_run(rows):
 @pytest.mark.requires_gpu
 def test_the_report_answers_the_issue_with_numbers(smoke):
     text = (smoke / "report.md").read_text(encoding="utf-8")
+    assert text.startswith("# Perspective-correct texturing: speed against float error (Romanyuk & Dudnyk)\n\n"
+                           f"- command: `wgpuviewer perspective --out {smoke} --suite smoke --quiet`\n- adapter: **")
     answers = text.split("## Answers")[1].split("## Checks")[0]
     for topic in ("Fastest on the GPU", "Fastest on the CPU", "Float32 incremental drift", "k-parallel and two-ended",
                   "Mitigations", "Large coordinates"):
