@@ -1,6 +1,6 @@
 """Atomic file writes: every output of the project (renders, maps, reports, settings, caches) goes through
-``atomic_open``, so a reader never sees a partial file, even after ``kill -9`` or a full disk. ``write_csv`` writes
-the tables of results (benchmark, studies) that way.
+``atomic_open``, so a reader never sees a partial file, even after ``kill -9`` or a full disk (the results tables
+of bench and the studies too: ``wgpuviewer.harness.table``).
 
 Every way a write can fail that the user can fix (the path is a folder, the disk is full, the folder is read-only
 or not ours, a parent is a file) is a one-line ``UserError`` naming the path and the fix; nothing is left behind.
@@ -13,10 +13,8 @@ temps no live process holds, so concurrent writers into one folder never delete 
 from __future__ import annotations
 
 import contextlib
-import csv
 import errno
 import glob
-import io
 import os
 import tempfile
 import time
@@ -182,17 +180,3 @@ def output_dir(path, option: str = "") -> Path:
                         f"{_FIXES.get(error.errno, 'choose another folder')}") from None
     return path
 
-
-def csv_cell(value) -> str:
-    """A CSV cell: floats with 6 significant digits, everything else as text."""
-    return f"{value:.6g}" if isinstance(value, float) else str(value)
-
-
-def write_csv(path, columns, rows) -> None:
-    """``rows`` (dicts with at least ``columns``) as a CSV file with a header, atomically."""
-    text = io.StringIO(newline="")
-    writer = csv.DictWriter(text, fieldnames=list(columns), lineterminator="\n", extrasaction="ignore")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: csv_cell(row[k]) for k in columns})
-    write_bytes(path, text.getvalue().encode("utf-8"))
