@@ -20,7 +20,8 @@ from .io import validate_height
 
 __all__ = ["generate", "validate_height", "resolve_backend", "VERSION", "KINDS"]
 
-#: Version of the map algorithms; part of every cache key (bump when an output changes).
+#: Version of the CPU reference implementations (``maptools/*.py``): part of every cache key, next to the hash of
+#: the kind's composed kernel source (which tracks the GPU path by itself); bump it when a CPU output changes.
 VERSION = "maptools-3"
 
 _notice_printed = False

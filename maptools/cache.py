@@ -1,6 +1,8 @@
 """Content-addressed cache of generated maps, for the renderer.
 
-Key = sha256 of (array bytes, shape, dtype, kind, resolved options, maptools VERSION). The backend is not
+Key = sha256 of (array bytes, shape, dtype, kind, resolved options, the kind's kernel source hash, maptools
+VERSION): an edited kernel, or a file it includes, gets new keys by itself; VERSION tracks the CPU reference. Keys of
+kinds outside the registry (the renderer's auto table) hold their own version in their options. The backend is not
 part of the key: GPU and CPU results agree within each kind's documented tolerance.
 Files: ``$WGPUVIEWER_CACHE_DIR`` (default ``~/.cache/wgpuviewer/maps``) / KIND / KEY[:2] / KEY.npy|.npz,
 written atomically (a concurrent reader never sees a partial file).
@@ -30,7 +32,7 @@ from wgpuviewer.core.io import WriteError, atomic_open, remove_abandoned_temps
 
 from . import VERSION, generate, validate_height
 from .io import read_maxmip, write_maxmip
-from .registry import get_kind
+from .registry import KINDS, get_kind
 
 CACHE_ENV = "WGPUVIEWER_CACHE_DIR"
 CACHE_MAX_ENV = "WGPUVIEWER_CACHE_MAX"
@@ -62,7 +64,8 @@ def cache_key(kind: str, height: np.ndarray, options: dict) -> str:
     a = np.ascontiguousarray(height)
     h = hashlib.sha256()
     h.update(json.dumps({"shape": list(a.shape), "dtype": str(a.dtype), "kind": kind,
-                         "options": options, "version": VERSION}, sort_keys=True).encode())
+                         "options": options, "version": VERSION,
+                         "kernels": KINDS[kind].source_hash() if kind in KINDS else None}, sort_keys=True).encode())
     h.update(memoryview(a).cast("B"))  # the bytes as they are, no copy
     return h.hexdigest()
 

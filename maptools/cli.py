@@ -200,6 +200,7 @@ def shard(items: list, i: int, n: int) -> list:
 
 def job_key(digest: str, kind: str, opts: dict, args, ext: str) -> str:
     blob = json.dumps({"input_sha256": digest, "kind": kind, "options": opts, "version": VERSION,
+                       "kernels": get_kind(kind).source_hash(),
                        "channel": args.channel, "nan_policy": args.nan_policy, "bits": args.bits, "ext": ext},
                       sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
@@ -272,7 +273,8 @@ def cmd_batch(args) -> int:
                 write_result(kind, result, out, args.bits)
                 with atomic_open(sidecar(out)) as fh:
                     fh.write(json.dumps({"key": key, "input": str(f), "input_sha256": digest, "kind": k,
-                                         "options": kopts[k], "version": VERSION}, sort_keys=True).encode())
+                                         "options": kopts[k], "version": VERSION,
+                                         "kernels": kind.source_hash()}, sort_keys=True).encode())
                 res.append((str(f), k, "ok", f"{out.name} ({time.perf_counter() - t0:.2f} s, {backend})"))
             except UserError as exc:
                 res.append((str(f), k, "FAILED", str(exc)))

@@ -7,6 +7,7 @@ batch tool's worker threads can share the single device.
 
 from __future__ import annotations
 
+import functools
 import threading
 
 import numpy as np
@@ -119,7 +120,13 @@ def runner(backend: str | None = None) -> MapGpu:
     return _runners[key]
 
 
-def _guard(fn):
+def _guard(*kernels: str):
+    """A GPU map function of ``kernels`` (files of ``wgsl/maps/``, for the cache key): run on the shared device
+    under the lock, with a kernel failure as a GpuKernelError."""
+    return functools.partial(_guarded, kernels=kernels)
+
+
+def _guarded(fn, kernels: tuple[str, ...]):
     def wrapped(height, **options):
         with _LOCK:
             try:
@@ -128,10 +135,11 @@ def _guard(fn):
                 raise GpuKernelError(f"GPU {fn.__name__} kernel failed: {_first_line(exc)}; use --backend cpu") from None
     wrapped.__name__ = fn.__name__
     wrapped.__doc__ = fn.__doc__
+    wrapped.kernels = kernels
     return wrapped
 
 
-@_guard
+@_guard("normal.wgsl")
 def normal(g: MapGpu, height: np.ndarray, *, strength: float = 1.0, y: str = "opengl", border: str = "repeat"):
     """GPU twin of cpu.normal (normal.wgsl)."""
     h, w = height.shape
@@ -146,7 +154,7 @@ def normal(g: MapGpu, height: np.ndarray, *, strength: float = 1.0, y: str = "op
     return g.read(dst, h * w * 3).reshape(h, w, 3)
 
 
-@_guard
+@_guard("complexity.wgsl")
 def complexity(g: MapGpu, height: np.ndarray, *, ksize: int = 3, dilate_kernel: int = 3, iterations: int = 5,
                gamma: float = 0.8, levels: int = 24, border: str = "reflect"):
     """GPU twin of cpu.complexity (complexity.wgsl: sobel_mag, dilate_h, dilate_v_finish)."""
@@ -169,7 +177,7 @@ def complexity(g: MapGpu, height: np.ndarray, *, ksize: int = 3, dilate_kernel: 
     return g.read(out, h * w).reshape(h, w).astype(np.uint8)
 
 
-@_guard
+@_guard("maxmip.wgsl")
 def maxmip(g: MapGpu, height: np.ndarray):
     """GPU twin of cpu.maxmip (maxmip.wgsl, one dispatch per level)."""
     sizes = cpu.level_sizes(*height.shape)
@@ -217,7 +225,7 @@ def _plain_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale
     return out, tops
 
 
-@_guard
+@_guard("distance.wgsl")
 def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05, subcells: int = 4):
     """GPU twin of distance.distance (distance.wgsl)."""
     from . import distance as dist
@@ -233,7 +241,7 @@ def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: f
     return g.read(out, w * h * slices).reshape(slices, h, w)
 
 
-@_guard
+@_guard("distance.wgsl", "distance_refined.wgsl")
 def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05,
                      subcells: int = 4, max_angle: float = 85.0, sectors: int = 4, bands: int = 8,
                      reach: float = 16.0, progress: bool = True):
@@ -284,7 +292,7 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
     return out
 
 
-@_guard
+@_guard("cone.wgsl")
 def cone(g: MapGpu, height: np.ndarray, *, max_ratio: float = 16.0, filter: str = "bilinear"):
     """GPU twin of cone.cone (cone.wgsl: ratio, then min3x3 for filter=bilinear)."""
     from . import cone as cn

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -9,7 +10,9 @@ from typing import Any
 
 import numpy as np
 
+from wgpuviewer.core.compute import source_hash
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.wgsl import compose
 
 from . import cone as cn
 from . import cpu, gpu, io
@@ -63,6 +66,19 @@ class Kind:
     writer: Callable[[Any, Any, str, int], None]  # (file object, result, extension, bits)
     extensions: tuple[str, ...]  # first = default for the batch tool
     check: Callable[[dict], None] = field(default=lambda opts: None)
+
+    @property
+    def kernels(self) -> tuple[str, ...]:
+        """The WGSL files (``wgsl/maps/``) its GPU path runs."""
+        return self.gpu.kernels
+
+    def source_hash(self) -> str:
+        """sha256 over the composed source of each of its kernels: part of every cache key of the kind, so an
+        edited kernel (or a file it includes) never serves a map built by the old one."""
+        h = hashlib.sha256()
+        for file in self.kernels:
+            h.update(source_hash(compose(f"maps/{file}")).encode())
+        return h.hexdigest()
 
     def resolve(self, options: dict) -> dict:
         """Options with defaults filled in and validated; unknown names are a UserError."""

@@ -178,3 +178,31 @@ def test_render_with_an_unwritable_cache_warns_once_and_renders(tmp_path, monkey
     assert err == [f"wgpuviewer: warning: map cache {blocker / 'maps'} cannot be written (Not a directory); "
                    "maps are rebuilt on every run: set WGPUVIEWER_CACHE_DIR to a writable folder"], err
     assert out.is_file()
+
+
+def test_an_edited_kernel_changes_the_cache_and_batch_keys(monkeypatch):
+    """The key holds the kind's composed kernel source: an edit of a kernel, or of a file it includes, never
+    serves a map the old kernel built; kinds that do not run the edited file keep their keys."""
+    import argparse
+
+    from wgpuviewer.core import wgsl
+
+    h = smooth_tileable(16, 16, 0)
+    args = argparse.Namespace(channel="auto", nan_policy="error", bits=8)
+    kinds = ("normal", "complexity", "distance_refined", "cone")
+
+    def keys():
+        return {k: (cache.cache_key(k, h, cache.get_kind(k).resolve({})), cli.job_key("d", k, {}, args, ".npy"))
+                for k in kinds}
+
+    before = keys()
+    read = wgsl.read_wgsl
+    for edited, changed in (("common/sobel.wgsl", {"normal", "complexity"}),
+                            ("maps/distance.wgsl", {"distance_refined"})):
+        monkeypatch.setattr(wgsl, "read_wgsl", lambda name, edited=edited: read(name) + ("// edited\n" if name == edited
+                                                                                     else ""))
+        after = keys()
+        assert {k for k in kinds if after[k][0] != before[k][0]} == changed, edited
+        assert {k for k in kinds if after[k][1] != before[k][1]} == changed, edited
+    monkeypatch.undo()
+    assert keys() == before
