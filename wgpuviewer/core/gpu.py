@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 from dataclasses import dataclass, field
 
 import cv2
@@ -73,8 +74,11 @@ class Gpu:
     adapter: wgpu.GPUAdapter
     device: wgpu.GPUDevice
     features: frozenset[str] = field(default_factory=frozenset)
-    #: Per-device caches (pipelines, layouts), keyed by their users.
+    #: Per-device caches (the compute kernels: ``core.compute.compute_for``; the renderer's pipelines), keyed by
+    #: their users.
     cache: dict = field(default_factory=dict)
+    #: Serialises GPU work of threads that share the device (the maptools batch workers); re-entrant.
+    lock: threading.RLock = field(default_factory=threading.RLock)
 
     @property
     def summary(self) -> str:
