@@ -1,138 +1,83 @@
-"""GPU paths of the map kinds: drive the WGSL compute kernels in ``wgsl/maps/``.
+"""GPU paths of the map kinds: drive the WGSL compute kernels in ``wgsl/maps/`` (through ``core.compute``).
 
-Maps travel as row-major f32 storage buffers (exact texel values, no sampler or format conversion);
-results are read back with ``device.queue.read_buffer``. One lock serialises GPU work so that the
-batch tool's worker threads can share the single device.
+Maps travel as row-major f32 storage buffers (exact texel values, no sampler or format conversion) and are read
+back whole. Every map function holds the device's lock, so that the batch tool's worker threads can share the
+single device.
 """
 
 from __future__ import annotations
 
 import functools
-import threading
 
 import numpy as np
-import wgpu
 
+from wgpuviewer.core.compute import compute_for
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import get_gpu
-from wgpuviewer.core.wgsl import compose
 
 from . import cpu
 
-_LOCK = threading.RLock()
-_WG = 8  # workgroup size (8x8) of every kernel
-
-
-class GpuKernelError(UserError):
-    """A kernel failed to compile, validate or run on this adapter."""
+#: What a user can do when a kernel fails or does not fit on their adapter.
+FIX = "use --backend cpu"
+_WG = (8, 8, 1)  # @workgroup_size of every kernel
 
 
 class MapGpu:
-    """Pipelines (compiled on first use) for one device."""
+    """The map kernels on one device: its ``Compute`` with maptools' kernel folder, workgroup size and fix."""
 
     def __init__(self, gpu):
         self.gpu = gpu
-        self.device: wgpu.GPUDevice = gpu.device
-        self._modules: dict[str, wgpu.GPUShaderModule] = {}
-        self._pipelines: dict[tuple[str, str], wgpu.GPUComputePipeline] = {}
-
-    def pipeline(self, file: str, entry: str) -> wgpu.GPUComputePipeline:
-        key = (file, entry)
-        if key not in self._pipelines:
-            source = compose(f"maps/{file}")  # the kernel with what it includes (wgsl/common/)
-            try:
-                if file not in self._modules:
-                    self._modules[file] = self.device.create_shader_module(
-                        label=f"maptools {file}", code=source.code)
-                self._pipelines[key] = self.device.create_compute_pipeline(
-                    label=f"maptools {file}:{entry}", layout="auto",
-                    compute={"module": self._modules[file], "entry_point": entry})
-            except (wgpu.GPUValidationError, wgpu.GPUPipelineError) as exc:
-                raise GpuKernelError(f"GPU kernel {file}:{entry} failed to build on {self.gpu.summary}: "
-                                     f"{source.locate(str(exc))}; use --backend cpu") from None
-        return self._pipelines[key]
+        self.compute = compute_for(gpu)
+        self.device = gpu.device
 
     # -- resources ---------------------------------------------------------------------------------
     def check_size(self, h: int, w: int, floats_per_texel: int = 1) -> None:
-        limits = self.device.limits
-        dim = limits["max-texture-dimension-2d"]
+        dim = self.device.limits["max-texture-dimension-2d"]
         if h > dim or w > dim:
             raise UserError(f"height map is {w}x{h}, larger than this adapter's max texture dimension {dim}; "
-                            f"downscale it or use --backend cpu")
-        need = h * w * 4 * floats_per_texel
-        cap = min(limits["max-storage-buffer-binding-size"], limits["max-buffer-size"])
-        if need > cap:
-            raise UserError(f"height map is {w}x{h}: {need} bytes exceed this adapter's storage buffer limit "
-                            f"{cap}; downscale it or use --backend cpu")
+                            f"downscale it or {FIX}")
+        self.compute.check_buffer(h * w * 4 * floats_per_texel, f"a {w}x{h} height map", f"downscale it or {FIX}")
 
-    def storage(self, data_or_size, label: str) -> wgpu.GPUBuffer:
-        usage = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC | wgpu.BufferUsage.COPY_DST
-        if isinstance(data_or_size, int):
-            return self.device.create_buffer(label=label, size=max(4, data_or_size), usage=usage)
-        return self.device.create_buffer_with_data(label=label, data=data_or_size, usage=usage)
+    def storage(self, data_or_size, label: str):
+        return self.compute.storage(data_or_size, label, FIX)
 
-    def uniform(self, words: list, label: str) -> wgpu.GPUBuffer:
+    def uniform(self, words: list, label: str):
         """Uniform buffer from a list of ints (u32) and floats (f32), padded to 16-byte multiples."""
         arr = np.zeros(((len(words) + 3) // 4) * 4, np.uint32)
         for i, v in enumerate(words):
             arr[i] = np.float32(v).view(np.uint32) if isinstance(v, float) else np.uint32(v)
-        return self.device.create_buffer_with_data(label=label, data=arr, usage=wgpu.BufferUsage.UNIFORM)
+        return self.compute.uniform(arr, label)
 
     def dispatch(self, encoder, file: str, entry: str, bindings: dict, w: int, h: int, d: int = 1) -> None:
         """One compute pass: ``entry`` of ``file`` over w x h (x d, one workgroup layer per slice) invocations."""
-        pipe = self.pipeline(file, entry)
-        group = self.device.create_bind_group(
-            label=f"maptools {file}:{entry}", layout=pipe.get_bind_group_layout(0),
-            entries=[{"binding": b, "resource": {"buffer": buf}} for b, buf in bindings.items()])
-        cp = encoder.begin_compute_pass(label=f"maptools {file}:{entry}")
-        cp.set_pipeline(pipe)
-        cp.set_bind_group(0, group)
-        cp.dispatch_workgroups((w + _WG - 1) // _WG, (h + _WG - 1) // _WG, d)
-        cp.end()
-
-    def submit(self, encoder, what: str) -> None:
-        try:
-            self.device.queue.submit([encoder.finish()])
-        except wgpu.GPUValidationError as exc:
-            raise GpuKernelError(f"GPU {what} failed validation on {self.gpu.summary}: {_first_line(exc)}; "
-                                 f"use --backend cpu") from None
-
-    def read(self, buf: wgpu.GPUBuffer, count: int) -> np.ndarray:
-        return np.frombuffer(self.device.queue.read_buffer(buf, 0, count * 4), np.float32).copy()
+        kernel = self.compute.kernel(f"maps/{file}", label=f"maptools {file}", fix=FIX)
+        kernel.dispatch(encoder, entry, bindings, threads=(w, h, d), size=_WG)
 
     def encoder(self, label: str):
-        return self.device.create_command_encoder(label=label)
+        return self.compute.encoder(label)
 
+    def submit(self, encoder) -> None:
+        self.compute.submit(encoder)
 
-def _first_line(exc: Exception) -> str:
-    text = str(exc).strip().splitlines()
-    return next((t.strip() for t in text if t.strip()), type(exc).__name__)
-
-
-_runners: dict[int, MapGpu] = {}
+    def read(self, buf, count: int) -> np.ndarray:
+        return self.compute.read(buf, count)
 
 
 def runner(backend: str | None = None) -> MapGpu:
-    gpu = get_gpu(None if backend in (None, "gpu") else backend)
-    key = id(gpu.device)
-    if key not in _runners:
-        _runners[key] = MapGpu(gpu)
-    return _runners[key]
+    return MapGpu(get_gpu(None if backend in (None, "gpu") else backend))
 
 
 def _guard(*kernels: str):
     """A GPU map function of ``kernels`` (files of ``wgsl/maps/``, for the cache key): run on the shared device
-    under the lock, with a kernel failure as a GpuKernelError."""
+    under its lock, with a wgpu error as a ``core.compute.KernelError``."""
     return functools.partial(_guarded, kernels=kernels)
 
 
 def _guarded(fn, kernels: tuple[str, ...]):
     def wrapped(height, **options):
-        with _LOCK:
-            try:
-                return fn(runner(), np.ascontiguousarray(height, np.float32), **options)
-            except (wgpu.GPUValidationError, wgpu.GPUPipelineError) as exc:
-                raise GpuKernelError(f"GPU {fn.__name__} kernel failed: {_first_line(exc)}; use --backend cpu") from None
+        g = runner()
+        with g.compute.guard(f"{fn.__name__} kernel", FIX):
+            return fn(g, np.ascontiguousarray(height, np.float32), **options)
     wrapped.__name__ = fn.__name__
     wrapped.__doc__ = fn.__doc__
     wrapped.kernels = kernels
@@ -150,7 +95,7 @@ def normal(g: MapGpu, height: np.ndarray, *, strength: float = 1.0, y: str = "op
                        "maptools normal params")
     enc = g.encoder("maptools normal")
     g.dispatch(enc, "normal.wgsl", "main", {0: params, 1: src, 2: dst}, w, h)
-    g.submit(enc, "normal")
+    g.submit(enc)
     return g.read(dst, h * w * 3).reshape(h, w, 3)
 
 
@@ -173,7 +118,7 @@ def complexity(g: MapGpu, height: np.ndarray, *, ksize: int = 3, dilate_kernel: 
     g.dispatch(enc, "complexity.wgsl", "sobel_mag", {0: params, 1: src, 2: mag, 3: maxbits}, w, h)
     g.dispatch(enc, "complexity.wgsl", "dilate_h", {0: params, 1: mag, 2: tmp}, w, h)
     g.dispatch(enc, "complexity.wgsl", "dilate_v_finish", {0: params, 1: tmp, 2: out, 3: maxbits}, w, h)
-    g.submit(enc, "complexity")
+    g.submit(enc)
     return g.read(out, h * w).reshape(h, w).astype(np.uint8)
 
 
@@ -189,7 +134,7 @@ def maxmip(g: MapGpu, height: np.ndarray):
         bufs.append(g.storage(ph * pw * 4, f"maptools maxmip level {k}"))
         params = g.uniform([sw, sh, pw, ph], f"maptools maxmip params {k}")
         g.dispatch(enc, "maxmip.wgsl", "reduce", {0: params, 1: bufs[k - 1], 2: bufs[k]}, pw, ph)
-    g.submit(enc, "maxmip")
+    g.submit(enc)
     out = [height.copy()]
     for k, (ph, pw) in enumerate(sizes[1:], start=1):
         out.append(g.read(bufs[k], ph * pw).reshape(ph, pw))
@@ -202,11 +147,8 @@ def _check_volume(g: MapGpu, w: int, h: int, slices: int, subcells: int, volumes
     g.check_size(h, w)
     need = w * h * slices * 4 * volumes
     rows = w * h * subcells * slices * 4  # the plain map's row pass keeps every sub-cell row
-    limits = g.device.limits
-    cap = min(limits["max-storage-buffer-binding-size"], limits["max-buffer-size"])
-    if max(need, rows) > cap or slices > limits["max-compute-workgroups-per-dimension"]:
-        raise UserError(f"a {w}x{h}x{slices} volume with {subcells}x{subcells} sub-cells needs a {max(need, rows)}-byte "
-                        f"buffer, more than this adapter's {cap}; use fewer --slices or --subcells, or --backend cpu")
+    g.compute.check_buffer(max(need, rows), f"a {w}x{h}x{slices} volume with {subcells}x{subcells} sub-cells",
+                           f"use fewer --slices or --subcells, or {FIX}")
 
 
 def _plain_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale: float, subcells: int, label: str):
@@ -237,7 +179,7 @@ def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: f
     src = g.storage(height, "maptools distance src")
     enc = g.encoder("maptools distance")
     out, _ = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance")
-    g.submit(enc, "distance")
+    g.submit(enc)
     return g.read(out, w * h * slices).reshape(slices, h, w)
 
 
@@ -259,7 +201,7 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
     src = g.storage(height, "maptools distance_refined src")
     enc = g.encoder("maptools distance_refined plain")
     plain, sub_tops = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance_refined")
-    g.submit(enc, "distance_refined plain")
+    g.submit(enc)
     directions = rf.bins(sectors, bands, max_angle)
     lists = [rf.entries(directions[s], subcells, w / h, reach) for s in range(sectors)]  # band independent
     levels = max(e.levels for e in lists)
@@ -284,7 +226,7 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
             g.dispatch(enc, "distance_refined.wgsl", "window_tops", {0: p, 1: src, 2: windows}, w, h, levels)
         g.dispatch(enc, "distance_refined.wgsl", "main",
                    {0: p, 1: plain, 2: vol, 3: sub_tops, 4: windows, 5: cbuf}, w, h, slices)
-        g.submit(enc, "distance_refined pass")
+        g.submit(enc)
         result = dist.round_down(g.read(vol, len(group) * n).astype(np.float64), np.float16)
         for i, b in enumerate(range(b0, b0 + len(group))):
             out[b * sectors + sector] = result[i * n:(i + 1) * n].reshape(slices, h, w)
@@ -311,5 +253,5 @@ def cone(g: MapGpu, height: np.ndarray, *, max_ratio: float = 16.0, filter: str 
     g.dispatch(enc, "cone.wgsl", "ratio", {0: params, 1: src, 2: raw}, w, h)
     if filter == "bilinear":
         g.dispatch(enc, "cone.wgsl", "min3x3", {0: params, 1: raw, 2: out}, w, h)
-    g.submit(enc, "cone")
+    g.submit(enc)
     return g.read(out if filter == "bilinear" else raw, h * w).reshape(h, w)

@@ -206,3 +206,20 @@ def test_an_edited_kernel_changes_the_cache_and_batch_keys(monkeypatch):
         assert {k for k in kinds if after[k][1] != before[k][1]} == changed, edited
     monkeypatch.undo()
     assert keys() == before
+
+
+@pytest.mark.requires_gpu
+def test_each_kind_declares_every_kernel_its_gpu_path_runs(monkeypatch):
+    """The key hashes the kernels a kind declares: they must be all that its GPU path dispatches."""
+    from maptools import gpu, registry
+
+    ran: set[str] = set()
+    dispatch = gpu.MapGpu.dispatch
+    monkeypatch.setattr(gpu.MapGpu, "dispatch", lambda self, enc, file, *a, **k: (ran.add(file),
+                                                                                   dispatch(self, enc, file, *a, **k)))
+    h = smooth_tileable(16, 16, 0)
+    for name, kind in registry.KINDS.items():
+        ran.clear()
+        options = {"progress": False} if name == "distance_refined" else {}
+        kind.gpu(h, **kind.resolve({}), **options)
+        assert ran == set(kind.kernels), name
