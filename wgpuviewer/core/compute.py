@@ -62,30 +62,31 @@ class Kernel:
         self.fix = fix
         self.layout = layout
         self._module: wgpu.GPUShaderModule | None = None
-        self._pipelines: dict[str, wgpu.GPUComputePipeline] = {}
+        self._pipelines: dict[tuple, wgpu.GPUComputePipeline] = {}
 
-    def pipeline(self, entry: str) -> wgpu.GPUComputePipeline:
-        """The pipeline of ``entry``; a compile or link error is a KernelError at the original file:line."""
-        if entry not in self._pipelines:
+    def pipeline(self, entry: str, constants: Mapping[str, float] | None = None) -> wgpu.GPUComputePipeline:
+        """The pipeline of ``entry`` (with its pipeline-overridable ``constants``); a compile or link error is a
+        KernelError at the original file:line."""
+        key = (entry, tuple(sorted((constants or {}).items())))
+        if key not in self._pipelines:
             device = self.compute.gpu.device
             try:
                 if self._module is None:
                     self._module = device.create_shader_module(label=self.label, code=self.source.code)
-                self._pipelines[entry] = device.create_compute_pipeline(
-                    label=f"{self.label}:{entry}", layout=self.layout,
-                    compute={"module": self._module, "entry_point": entry})
+                stage = {"module": self._module, "entry_point": entry}
+                if constants:
+                    stage["constants"] = dict(constants)
+                self._pipelines[key] = device.create_compute_pipeline(
+                    label=f"{self.label}:{entry}", layout=self.layout, compute=stage)
             except (wgpu.GPUValidationError, wgpu.GPUPipelineError) as exc:
                 raise KernelError(f"kernel {self.label}:{entry} failed to build on {self.compute.gpu.summary}: "
                                   f"{self.source.locate(str(exc))}; {self.fix}") from None
-        return self._pipelines[entry]
+        return self._pipelines[key]
 
     def bind(self, entry: str, bindings: Mapping[int, object], group: int = 0) -> wgpu.GPUBindGroup:
-        """Bind group ``group`` of ``entry``'s pipeline: binding number -> buffer (bound whole), sampler or view."""
+        """Bind group ``group`` of ``entry``'s pipeline from binding number -> resource."""
         layout = self.pipeline(entry).get_bind_group_layout(group)
-        return self.compute.gpu.device.create_bind_group(
-            label=f"{self.label}:{entry}:{group}", layout=layout,
-            entries=[{"binding": b, "resource": {"buffer": r} if isinstance(r, wgpu.GPUBuffer) else r}
-                     for b, r in sorted(bindings.items())])
+        return self.compute.bind_group(layout, bindings, f"{self.label}:{entry}:{group}")
 
     def dispatch(self, encoder: wgpu.GPUCommandEncoder, entry: str, bindings: Mapping[int, object] | None,
                  threads: Sequence[int], size: Sequence[int] = (8, 8, 1),
@@ -141,6 +142,14 @@ class Compute:
                 raise LimitError(f"{what}: {n} workgroups along {axis}, more than the {limit} {self.gpu.summary} "
                                  f"allows; {fix}")
         return counts
+
+    def bind_group(self, layout: wgpu.GPUBindGroupLayout, bindings: Mapping[int, object],
+                   label: str) -> wgpu.GPUBindGroup:
+        """A bind group of ``layout``: binding number -> buffer (bound whole), sampler or texture view."""
+        return self.device.create_bind_group(
+            label=label, layout=layout,
+            entries=[{"binding": b, "resource": {"buffer": r} if isinstance(r, wgpu.GPUBuffer) else r}
+                     for b, r in sorted(bindings.items())])
 
     # -- buffers -----------------------------------------------------------------------------------
     def storage(self, data_or_size: np.ndarray | bytes | int, label: str, fix: str) -> wgpu.GPUBuffer:

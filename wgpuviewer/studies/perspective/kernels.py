@@ -12,9 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 import wgpu
 
-from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.compute import compute_for, workgroups
 from wgpuviewer.core.gpu import Gpu
-from wgpuviewer.core.wgsl import Generated, compose
+from wgpuviewer.core.wgsl import Generated
 
 from .geometry import Spans, defined_range
 from .methods import METHODS, Method, Result, fixed_setup, split
@@ -25,15 +25,12 @@ SOURCE = "studies/perspective/kernels.wgsl"
 FORMS = {"direct": ("per_pixel", 0), "span": ("per_pixel", 1), "incremental": ("sequential", 2),
          "reanchor": ("sequential", 3), "kahan": ("sequential", 4), "double_single": ("sequential", 5),
          "fixed16_16": ("sequential", 6)}
-WORKGROUP = 64
-MAX_GROUPS = 65535  # per dispatch dimension
+WORKGROUP = 64  # @workgroup_size of every kernel
+#: What a user can do when a kernel does not build on their adapter, or the spans do not fit its limits.
+FIX = "run on another adapter (--backend)"
+FEWER = "use fewer spans"
 PARAMS_SIZE = 6 * 16 + 16  # six vec4 + span_length, span_count, param, one (common.wgsl's Params)
 SPAN_STRIDE = 32  # common.wgsl's Span
-
-
-def _groups(threads: int, rows: int = 1) -> tuple[int, int, int]:
-    """Workgroups for ``threads`` along x (and ``rows`` along y)."""
-    return max(-(-threads // WORKGROUP), 1), rows, 1
 
 
 def pack_params(method: Method, coefficients: np.ndarray, spans: Spans) -> bytes:
@@ -67,14 +64,12 @@ def kernels_for(gpu: Gpu) -> Kernels:
 
 
 class Kernels:
-    """The study's shader module and its pipelines (compiled on first use) for one device."""
+    """The study's shader module (a ``core.compute`` kernel with the shared layout) and its buffers, on one device."""
 
     def __init__(self, gpu: Gpu):
         self.gpu = gpu
+        self.compute = compute_for(gpu)
         device = gpu.device
-        forms = "".join(f"const FORM_{name.upper()}: u32 = {form}u;\n" for name, (_, form) in FORMS.items())
-        self.source = compose(Generated("<generated: kernel forms>", forms), SOURCE)
-        self.module = device.create_shader_module(label="perspective", code=self.source.code)
         C = wgpu.ShaderStage.COMPUTE
         storage = wgpu.BufferBindingType.storage
         self.layout = device.create_bind_group_layout(label="perspective", entries=[
@@ -82,68 +77,50 @@ class Kernels:
             {"binding": 1, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.read_only_storage}},
             *({"binding": b, "visibility": C, "buffer": {"type": storage}} for b in (2, 3, 4)),
         ])
-        self.pipeline_layout = device.create_pipeline_layout(label="perspective", bind_group_layouts=[self.layout])
-        self._pipelines: dict[str, wgpu.GPUComputePipeline] = {}
+        forms = "".join(f"const FORM_{name.upper()}: u32 = {form}u;\n" for name, (_, form) in FORMS.items())
+        self.kernel = self.compute.kernel(
+            Generated("<generated: kernel forms>", forms), SOURCE, label="perspective", fix=FIX,
+            layout=device.create_pipeline_layout(label="perspective", bind_group_layouts=[self.layout]))
 
     def pipeline(self, kernel: str) -> wgpu.GPUComputePipeline:
         """The pipeline of a kernel: its own entry point, or the shared one specialised to its form."""
-        if kernel not in self._pipelines:
-            stage = {"module": self.module, "entry_point": kernel}
-            if kernel in FORMS:
-                entry, form = FORMS[kernel]
-                stage = {**stage, "entry_point": entry, "constants": {"FORM": form}}
-            try:
-                self._pipelines[kernel] = self.gpu.device.create_compute_pipeline(
-                    label=f"perspective:{kernel}", layout=self.pipeline_layout, compute=stage)
-            except (wgpu.GPUValidationError, wgpu.GPUPipelineError) as exc:
-                raise UserError(f"perspective kernel {kernel} failed to build on {self.gpu.summary}: "
-                                f"{self.source.locate(str(exc))}") from None
-        return self._pipelines[kernel]
+        if kernel in FORMS:
+            entry, form = FORMS[kernel]
+            return self.kernel.pipeline(entry, {"FORM": form})
+        return self.kernel.pipeline(kernel)
 
     def outputs(self, spans: Spans) -> Outputs:
         """Output buffers for ``spans`` (several dispatches may share them, e.g. for timing)."""
-        device = self.gpu.device
         pixels = spans.count * spans.length
-        limit = min(device.limits["max-storage-buffer-binding-size"], device.limits["max-buffer-size"])
-        if pixels * 8 > limit:
-            raise UserError(f"{spans.count} spans of {spans.length} pixels need {pixels * 8} bytes of uv output, "
-                            f"more than this adapter's storage buffer limit {limit}; use fewer spans")
-        U = wgpu.BufferUsage
-        return Outputs(device.create_buffer(label="perspective:starts", size=16 * spans.count, usage=U.STORAGE),
-                       device.create_buffer(label="perspective:uv", size=8 * pixels, usage=U.STORAGE | U.COPY_SRC),
-                       device.create_buffer(label="perspective:flags", size=4 * pixels, usage=U.STORAGE | U.COPY_SRC))
+        what = f"{spans.count} spans of {spans.length} pixels"
+        return Outputs(self.compute.storage(16 * spans.count, f"perspective:starts of {what}", FEWER),
+                       self.compute.storage(8 * pixels, f"perspective:uv of {what}", FEWER),
+                       self.compute.storage(4 * pixels, f"perspective:flags of {what}", FEWER))
 
     def prepare(self, name: str, coefficients: np.ndarray, spans: Spans, outputs: Outputs | None = None) -> Dispatch:
         """Inputs, bind group and dispatches of method ``name`` on ``spans`` (into ``outputs``, or new ones)."""
         method = METHODS[name]
-        device = self.gpu.device
-        out = outputs or self.outputs(spans)
-        U = wgpu.BufferUsage
-        params = device.create_buffer_with_data(label="perspective:params", usage=U.UNIFORM,
-                                                data=pack_params(method, coefficients, spans))
-        span_buffer = device.create_buffer_with_data(label="perspective:spans", usage=U.STORAGE,
-                                                     data=pack_spans(method, coefficients, spans))
-        group = device.create_bind_group(layout=self.layout, entries=[
-            {"binding": b, "resource": {"buffer": buf}}
-            for b, buf in enumerate((params, span_buffer, out.starts, out.uv, out.flags))
-        ])
+        what = f"{spans.count} spans of {spans.length} pixels"
         threads = method.threads_per_span(spans.length)
         if threads == 0:  # one thread per pixel: x along the span, y over the spans
-            steps = [("span_setup", _groups(spans.count))] if method.kernel == "span" else []
-            steps.append((method.kernel, _groups(spans.length, spans.count)))
+            steps = [("span_setup", (spans.count,))] if method.kernel == "span" else []
+            steps.append((method.kernel, (spans.length, spans.count)))
         else:
-            steps = [(method.kernel, _groups(spans.count * threads))]
-        for _, groups in steps:
-            if max(groups) > MAX_GROUPS:
-                raise UserError(f"{spans.count} spans of {spans.length} pixels need {groups} workgroups, more than "
-                                f"{MAX_GROUPS} per dimension; use fewer spans")
-        return Dispatch(self, group, [(self.pipeline(e), g) for e, g in steps], out, spans)
+            steps = [(method.kernel, (spans.count * threads,))]
+        counts = [self.compute.check_workgroups(workgroups(t, (WORKGROUP,)), what, FEWER) for _, t in steps]
+        out = outputs or self.outputs(spans)
+        params = self.compute.uniform(pack_params(method, coefficients, spans), "perspective:params")
+        span_buffer = self.compute.storage(pack_spans(method, coefficients, spans), f"perspective:spans of {what}",
+                                           FEWER)
+        group = self.compute.bind_group(self.layout, dict(enumerate((params, span_buffer, out.starts, out.uv,
+                                                                     out.flags))), "perspective")
+        return Dispatch(self, group, [(self.pipeline(e), c) for (e, _), c in zip(steps, counts)], out, spans)
 
     def run(self, name: str, coefficients: np.ndarray, spans: Spans) -> Result:
         dispatch = self.prepare(name, coefficients, spans)
-        encoder = self.gpu.device.create_command_encoder(label=f"perspective:{name}")
+        encoder = self.compute.encoder(f"perspective:{name}")
         dispatch.record(encoder)
-        self.gpu.device.queue.submit([encoder.finish()])
+        self.compute.submit(encoder)
         return dispatch.read()
 
 
@@ -172,8 +149,8 @@ class Dispatch:
         compute.end()
 
     def read(self) -> Result:
-        queue = self.kernels.gpu.device.queue
+        compute = self.kernels.compute
         shape = (self.spans.count, self.spans.length)
-        uv = np.frombuffer(queue.read_buffer(self.outputs.uv), np.float32).reshape(*shape, 2)
-        flagged = np.frombuffer(queue.read_buffer(self.outputs.flags), np.uint32).reshape(shape) != 0
+        uv = compute.read(self.outputs.uv, 2 * self.spans.count * self.spans.length).reshape(*shape, 2)
+        flagged = compute.read(self.outputs.flags, self.spans.count * self.spans.length, np.uint32).reshape(shape) != 0
         return Result(uv[..., 0].copy(), uv[..., 1].copy(), flagged)
