@@ -54,10 +54,10 @@ class Kernel:
     ``layout``: "auto" (bind group layouts derived from the shader) or a pipeline layout of the caller.
     ``fix``: what a user can do when it fails on their adapter (e.g. "use --backend cpu")."""
 
-    def __init__(self, compute: Compute, parts: tuple[str | Generated, ...], label: str, fix: str, layout="auto"):
+    def __init__(self, compute: Compute, source: Module, label: str, fix: str, layout="auto"):
         self.compute = compute
-        self.source = compose(*parts)
-        self.source_hash = source_hash(self.source)
+        self.source = source
+        self.source_hash = source_hash(source)
         self.label = label
         self.fix = fix
         self.layout = layout
@@ -90,16 +90,18 @@ class Kernel:
 
     def dispatch(self, encoder: wgpu.GPUCommandEncoder, entry: str, bindings: Mapping[int, object] | None,
                  threads: Sequence[int], size: Sequence[int] = (8, 8, 1),
-                 groups: Sequence[wgpu.GPUBindGroup] = ()) -> None:
+                 groups: Sequence[wgpu.GPUBindGroup | None] = ()) -> None:
         """One compute pass of ``entry`` over ``threads`` invocations in workgroups of ``size`` (the kernel's
-        @workgroup_size): group 0 from ``bindings`` (binding number -> resource), then ``groups`` as given."""
+        @workgroup_size): group 0 from ``bindings`` (binding number -> resource), then ``groups`` as given (None:
+        a group the kernel does not use)."""
         counts = self.compute.check_workgroups(workgroups(threads, size), f"{self.label}:{entry}", self.fix)
         pipeline = self.pipeline(entry)
         bound = ([self.bind(entry, bindings)] if bindings is not None else []) + list(groups)
         cp = encoder.begin_compute_pass(label=f"{self.label}:{entry}")
         cp.set_pipeline(pipeline)
         for index, group in enumerate(bound):
-            cp.set_bind_group(index, group)
+            if group is not None:
+                cp.set_bind_group(index, group)
         cp.dispatch_workgroups(*counts)
         cp.end()
 
@@ -112,14 +114,30 @@ class Compute:
         self.device: wgpu.GPUDevice = gpu.device
         self.lock = gpu.lock
         self._kernels: dict[tuple, Kernel] = {}
+        self._layouts: dict[str, wgpu.GPUPipelineLayout] = {}
 
     def kernel(self, *parts: str | Generated, label: str, fix: str, layout="auto") -> Kernel:
-        """The kernel composed of ``parts``, made once per device (per parts and layout)."""
-        key = (parts, label, layout)
+        """The kernel composed of ``parts`` (WGSL files and generated pieces): ``kernel_of`` their module."""
+        return self.kernel_of(compose(*parts), label=label, fix=fix, layout=layout)
+
+    def kernel_of(self, source: Module, *, label: str, fix: str, layout="auto") -> Kernel:
+        """The kernel of a composed module, made once per device per source (an edited file is a new kernel),
+        label and layout."""
+        key = (source_hash(source), label, layout)
         with self.lock:
             if key not in self._kernels:
-                self._kernels[key] = Kernel(self, parts, label, fix, layout)
+                self._kernels[key] = Kernel(self, source, label, fix, layout)
             return self._kernels[key]
+
+    def layout(self, groups: Sequence[Sequence[dict]], label: str) -> wgpu.GPUPipelineLayout:
+        """The pipeline layout of bind groups with these layout entries (made once per device per entries)."""
+        key = repr([list(g) for g in groups])
+        with self.lock:
+            if key not in self._layouts:
+                self._layouts[key] = self.device.create_pipeline_layout(label=label, bind_group_layouts=[
+                    self.device.create_bind_group_layout(label=f"{label}:{i}", entries=list(g))
+                    for i, g in enumerate(groups)])
+            return self._layouts[key]
 
     # -- limits ------------------------------------------------------------------------------------
     @property

@@ -14,18 +14,20 @@ from dataclasses import dataclass
 import numpy as np
 import wgpu
 
+from wgpuviewer.core.compute import Kernel, compute_for
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, get_gpu, mip_chain
 
 from .filters import FILTER_GROUP, get_filter, pack_filter_params, resolve_filter_params, sampler_descriptor
 from .maps import binding
-from .probe import dispatch, io_bind_group, io_layout_entries, material_bind_group, material_layout_entries
+from .probe import FEWER, FIX, dispatch, io_layout_entries, material_bind_group, material_layout_entries
 from .shaders import compose_technique
 from .techniques import get_technique, resolve_params
 
 SAMPLE_STRIDE = 48  # FilterSample: vec2f uv, dx, dy, pad, vec4f view
 OUT_STRIDE = 32  # FilterOut: vec4f value, u32 texels, depth_fetches, hidden, flags
 TEXTURE_FORMAT = "rgba16float"  # as the renderer's albedo
+ENTRY = "filter_probe_main"
 
 
 @dataclass
@@ -37,32 +39,17 @@ class FilterProbeResult:
     flags: np.ndarray  # (N,) uint32 filters.FLAGS bits
 
 
-def _pipeline(gpu: Gpu, technique_name: str, filter_name: str):
-    cache = gpu.cache.setdefault("filter_probe_pipelines", {})
-    key = (technique_name, filter_name)
-    if key not in cache:
-        technique = get_technique(technique_name)
-        device = gpu.device
-        code = compose_technique(technique, "filter_probe", filter_name).code
-        module = device.create_shader_module(label=f"filter-probe:{technique_name}/{filter_name}", code=code)
-        C = wgpu.ShaderStage.COMPUTE
-        layouts = [
-            device.create_bind_group_layout(label="filter-probe:io", entries=io_layout_entries(C)),
-            device.create_bind_group_layout(label="filter-probe:material",
-                                            entries=material_layout_entries(technique, ("albedo",))),
-        ]
-        layouts += [device.create_bind_group_layout(label="filter-probe:none", entries=[])] * (FILTER_GROUP - 2)
-        layouts.append(device.create_bind_group_layout(label="filter-probe:filter", entries=[
-            {"binding": 0, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.uniform}},
-            {"binding": 1, "visibility": C, "sampler": {"type": wgpu.SamplerBindingType.filtering}},
-        ]))
-        layout = device.create_pipeline_layout(label="filter-probe", bind_group_layouts=layouts)
-        pipeline = device.create_compute_pipeline(
-            label=f"filter-probe:{technique_name}/{filter_name}", layout=layout,
-            compute={"module": module, "entry_point": "filter_probe_main"},
-        )
-        cache[key] = (pipeline, layouts)
-    return cache[key]
+def _kernel(gpu: Gpu, technique_name: str, filter_name: str) -> Kernel:
+    technique = get_technique(technique_name)
+    C = wgpu.ShaderStage.COMPUTE
+    groups = [io_layout_entries(C), material_layout_entries(technique, ("albedo",))]
+    groups += [[]] * (FILTER_GROUP - 2)
+    groups.append([{"binding": 0, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.uniform}},
+                   {"binding": 1, "visibility": C, "sampler": {"type": wgpu.SamplerBindingType.filtering}}])
+    compute = compute_for(gpu)
+    return compute.kernel_of(compose_technique(technique, "filter_probe", filter_name),
+                             label=f"filter-probe:{technique_name}/{filter_name}", fix=FIX,
+                             layout=compute.layout(groups, "filter-probe"))
 
 
 def texture_levels(texture: np.ndarray) -> list[np.ndarray]:
@@ -112,24 +99,22 @@ def filter_probe(
     uv, dx, dy, view = (np.broadcast_to(c, (n, c.shape[1])) for c in columns)
 
     gpu = get_gpu(backend, quiet=True)
-    device = gpu.device
-    pipeline, layouts = _pipeline(gpu, tech.name, f.name)
+    compute = compute_for(gpu)
+    kernel = _kernel(gpu, tech.name, f.name)
+    pipeline = kernel.pipeline(ENTRY)
     samples = np.zeros((n, SAMPLE_STRIDE // 4), np.float32)
     samples[:, 0:2], samples[:, 2:4], samples[:, 4:6], samples[:, 8:11] = uv, dx, dy, view
-    S = wgpu.BufferUsage
-    in_buf = device.create_buffer_with_data(label="filter-probe:samples", data=samples, usage=S.STORAGE)
-    out_buf = device.create_buffer(label="filter-probe:out", size=n * OUT_STRIDE, usage=S.STORAGE | S.COPY_SRC)
+    in_buf = compute.storage(samples, f"filter-probe:{n} samples", FEWER)
+    out_buf = compute.storage(n * OUT_STRIDE, f"filter-probe:out of {n} samples", FEWER)
     albedo = create_texture(gpu, mip_chain(np.asarray(texture, np.float32)), TEXTURE_FORMAT, "filter-probe:texture")
-    material = material_bind_group(gpu, layouts[1], tech, height, height_scale, tech_values, "repeat",
-                                   extra=((binding("albedo"), albedo),))
-    params = device.create_buffer_with_data(label="filter-probe:params", data=pack_filter_params(f, values),
-                                            usage=S.UNIFORM)
-    sampler = device.create_sampler(label=f"filter-probe:{f.name}", **sampler_descriptor(f, values))
-    filter_group = device.create_bind_group(layout=layouts[FILTER_GROUP], entries=[
-        {"binding": 0, "resource": {"buffer": params}}, {"binding": 1, "resource": sampler}])
-    groups = [io_bind_group(gpu, layouts[0], in_buf, out_buf), material]
-    groups += [None] * (FILTER_GROUP - 2) + [filter_group]
-    raw = dispatch(gpu, pipeline, groups, n, out_buf, OUT_STRIDE)
+    material = material_bind_group(gpu, pipeline.get_bind_group_layout(1), tech, height, height_scale, tech_values,
+                                   "repeat", extra=((binding("albedo"), albedo),))
+    params = compute.uniform(pack_filter_params(f, values), "filter-probe:params")
+    sampler = gpu.device.create_sampler(label=f"filter-probe:{f.name}", **sampler_descriptor(f, values))
+    filter_group = compute.bind_group(pipeline.get_bind_group_layout(FILTER_GROUP), {0: params, 1: sampler},
+                                      f"filter-probe:{f.name}")
+    groups = [material, *[None] * (FILTER_GROUP - 2), filter_group]
+    raw = dispatch(kernel, ENTRY, groups, n, in_buf, out_buf, OUT_STRIDE)
     u32 = raw.view(np.uint32)
     return FilterProbeResult(value=raw.view(np.float32)[:, 0:4].copy(), texels=u32[:, 4].copy(),
                              depth_fetches=u32[:, 5].copy(), hidden=u32[:, 6].copy(), flags=u32[:, 7].copy())

@@ -19,6 +19,7 @@ import numpy as np
 import wgpu
 
 from maptools import validate_height
+from wgpuviewer.core.compute import Kernel, compute_for
 from wgpuviewer.core.errors import InputError
 from wgpuviewer.core.gpu import Gpu, get_gpu
 
@@ -28,8 +29,12 @@ from .techniques import TECHNIQUES, get_technique, resolve_params
 
 RAY_STRIDE = 32  # ProbeRay: vec2f uv, vec2f pad, vec4f view
 HIT_STRIDE = 32  # ProbeHit: vec2f uv, f32 depth, u32 fetches, u32 capped, u32 layers, vec2u pad
-_WORKGROUP = 64
-_MAX_GROUPS = 65535  # per dispatch dimension
+WORKGROUP = 64  # @workgroup_size of the probe entry points
+_MAX_GROUPS = 65535  # workgroups along x of a large set (common/probe_index.wgsl folds the 2D grid at this width)
+ENTRY = "probe_main"
+#: What a user can do when the probe kernel does not build on their adapter, or the rays do not fit its limits.
+FIX = "fix the WGSL at that line, or run on another adapter (backend=...)"
+FEWER = "trace fewer rays per call"
 #: Largest relief depth the probe traces (UV units): beyond it float32 steps overflow; scenes allow up to 1.
 MAX_HEIGHT_SCALE = 1e3
 #: Clamp addressing: entry uv farther out than this many texels of float32 resolution (2^-6 texel) is flagged.
@@ -60,22 +65,13 @@ def material_layout_entries(technique, textures: tuple[str, ...] = ()) -> list[d
     ]
 
 
-def _pipeline(gpu: Gpu, technique_name: str) -> tuple[wgpu.GPUComputePipeline, list]:
-    cache = gpu.cache.setdefault("probe_pipelines", {})
-    if technique_name not in cache:
-        technique = get_technique(technique_name)
-        device = gpu.device
-        module = device.create_shader_module(label=f"probe:{technique.name}",
-                                             code=compose_technique(technique, "probe").code)
-        C = wgpu.ShaderStage.COMPUTE
-        io_layout = device.create_bind_group_layout(label="probe:io", entries=io_layout_entries(C))
-        material_layout = device.create_bind_group_layout(label="probe:material", entries=material_layout_entries(technique))
-        layout = device.create_pipeline_layout(label="probe", bind_group_layouts=[io_layout, material_layout])
-        pipeline = device.create_compute_pipeline(
-            label=f"probe:{technique.name}", layout=layout, compute={"module": module, "entry_point": "probe_main"}
-        )
-        cache[technique_name] = (pipeline, [io_layout, material_layout])
-    return cache[technique_name]
+def _kernel(gpu: Gpu, technique_name: str) -> Kernel:
+    technique = get_technique(technique_name)
+    C = wgpu.ShaderStage.COMPUTE
+    compute = compute_for(gpu)
+    layout = compute.layout([io_layout_entries(C), material_layout_entries(technique)], "probe")
+    return compute.kernel_of(compose_technique(technique, "probe"), label=f"probe:{technique.name}", fix=FIX,
+                             layout=layout)
 
 
 def probe(
@@ -157,18 +153,16 @@ def _trace(tech, values: dict, height: np.ndarray, uv: np.ndarray, view: np.ndar
     """Run the technique's probe kernel on the rays (uv, view: float64 (n, 2), (n, 3), n >= 1)."""
     n = len(uv)
     gpu = get_gpu(backend, quiet=True)
-    device = gpu.device
-    pipeline, (io_layout, material_layout) = _pipeline(gpu, tech.name)
-
+    compute = compute_for(gpu)
+    kernel = _kernel(gpu, tech.name)
     rays = np.zeros((n, RAY_STRIDE // 4), np.float32)
     rays[:, 0:2] = uv
     rays[:, 4:7] = view
-    S = wgpu.BufferUsage
-    ray_buf = device.create_buffer_with_data(label="probe:rays", data=rays, usage=S.STORAGE)
-    hit_buf = device.create_buffer(label="probe:hits", size=n * HIT_STRIDE, usage=S.STORAGE | S.COPY_SRC)
-    material_group = material_bind_group(gpu, material_layout, tech, height, height_scale, values, address)
-    raw = dispatch(gpu, pipeline, [io_bind_group(gpu, io_layout, ray_buf, hit_buf), material_group], n, hit_buf,
-                   HIT_STRIDE)
+    ray_buf = compute.storage(rays, f"probe:{n} rays", FEWER)
+    hit_buf = compute.storage(n * HIT_STRIDE, f"probe:hits of {n} rays", FEWER)
+    layout = kernel.pipeline(ENTRY).get_bind_group_layout(1)
+    material_group = material_bind_group(gpu, layout, tech, height, height_scale, values, address)
+    raw = dispatch(kernel, ENTRY, [material_group], n, ray_buf, hit_buf, HIT_STRIDE)
     f32 = raw.view(np.float32)
     u32 = raw.view(np.uint32)
     return ProbeResult(uv=f32[:, 0:2].astype(np.float64), depth=f32[:, 2].copy(), fetches=u32[:, 3].copy(),
@@ -181,11 +175,6 @@ def io_layout_entries(visibility) -> list[dict]:
         {"binding": 0, "visibility": visibility, "buffer": {"type": wgpu.BufferBindingType.read_only_storage}},
         {"binding": 1, "visibility": visibility, "buffer": {"type": wgpu.BufferBindingType.storage}},
     ]
-
-
-def io_bind_group(gpu: Gpu, layout, inputs: wgpu.GPUBuffer, outputs: wgpu.GPUBuffer) -> wgpu.GPUBindGroup:
-    return gpu.device.create_bind_group(layout=layout, entries=[
-        {"binding": 0, "resource": {"buffer": inputs}}, {"binding": 1, "resource": {"buffer": outputs}}])
 
 
 def material_bind_group(gpu: Gpu, layout, tech, height: np.ndarray, height_scale: float, values: dict,
@@ -206,29 +195,20 @@ def material_bind_group(gpu: Gpu, layout, tech, height: np.ndarray, height_scale
     sampler = device.create_sampler(
         label="probe:sampler", address_mode_u=mode, address_mode_v=mode, mag_filter="linear", min_filter="linear"
     )
-    return device.create_bind_group(
-        layout=layout,
-        entries=[
-            {"binding": PARAMS_BINDING, "resource": {"buffer": params_buf}},
-            {"binding": SAMPLER_BINDING, "resource": sampler},
-            *({"binding": b, "resource": texture.create_view()} for b, texture in [*maps, *extra]),
-        ],
-    )
+    return compute_for(gpu).bind_group(layout, {PARAMS_BINDING: params_buf, SAMPLER_BINDING: sampler,
+                                                 **{b: texture.create_view() for b, texture in [*maps, *extra]}},
+                                        "probe:material")
 
 
-def dispatch(gpu: Gpu, pipeline, groups: list, n: int, out: wgpu.GPUBuffer, stride: int) -> np.ndarray:
-    """Run a probe kernel over ``n`` items with bind groups ``groups`` (index = group; None: skip) and read
-    ``out`` back as (n, stride) bytes."""
-    device = gpu.device
-    count = -(-n // _WORKGROUP)
-    encoder = device.create_command_encoder(label="probe")
-    pass_ = encoder.begin_compute_pass(label="probe")
-    pass_.set_pipeline(pipeline)
-    for index, group in enumerate(groups):
-        if group is not None:
-            pass_.set_bind_group(index, group)
-    # Large sets: a 2D grid of workgroups; the shader folds it back into one index.
-    pass_.dispatch_workgroups(min(count, _MAX_GROUPS), -(-count // _MAX_GROUPS), 1)
-    pass_.end()
-    device.queue.submit([encoder.finish()])
-    return np.frombuffer(device.queue.read_buffer(out), np.uint8).reshape(n, stride)
+def dispatch(kernel: Kernel, entry: str, groups: list, n: int, inputs: wgpu.GPUBuffer, outputs: wgpu.GPUBuffer,
+             stride: int) -> np.ndarray:
+    """Run a probe kernel over ``n`` items: group 0 binds ``inputs`` and ``outputs``, then ``groups`` (index - 1 =
+    group; None: skip); read ``outputs`` back as (n, stride) bytes."""
+    compute = kernel.compute
+    count = -(-n // WORKGROUP)
+    encoder = compute.encoder("probe")
+    # Large sets: a 2D grid of workgroups; the shader folds it back into one index (common/probe_index.wgsl).
+    threads = (WORKGROUP * min(count, _MAX_GROUPS), -(-count // _MAX_GROUPS))
+    kernel.dispatch(encoder, entry, {0: inputs, 1: outputs}, threads, size=(WORKGROUP,), groups=groups)
+    compute.submit(encoder)
+    return compute.read(outputs, n * stride, np.uint8).reshape(n, stride)
