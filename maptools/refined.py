@@ -1,4 +1,4 @@
-"""The direction-binned refined distance map (seed 000 made to pay): CPU reference and the geometry its GPU bake
+"""The direction-binned refined distance map (Romanyuk et al. 2017, made to pay): CPU reference and the geometry its GPU bake
 (``wgsl/maps/distance_refined.wgsl``) shares. docs/maps.md states the contract and the safety argument.
 
 A tracer's ray keeps its direction, so it may read a value made for a *set* of directions containing its own. The

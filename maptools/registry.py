@@ -206,7 +206,7 @@ KINDS: dict[str, Kind] = {
     ),
     "complexity": Kind(
         name="complexity",
-        description="thesis complexity map (Sobel magnitude, dilation, gamma, quantised levels), 8-bit",
+        description="complexity map of the adaptive-POM thesis (Sobel magnitude, dilation, gamma, quantised levels), 8-bit",
         options=(
             Option("ksize", 3, int, "Sobel kernel size (listing 3; 5 also allowed)", choices=(3, 5)),
             Option("dilate_kernel", 3, int, "dilation kernel size (listing 3, text 5)", lo=1, hi=99),
@@ -239,7 +239,7 @@ KINDS: dict[str, Kind] = {
     ),
     "distance_refined": Kind(
         name="distance_refined",
-        description="direction-binned refined distance map (seed 000), float16 (V, Dz, H, W) rounded down: one "
+        description="direction-binned refined distance map (Romanyuk et al. 2017), float16 (V, Dz, H, W) rounded down: one "
                     "volume per bin of ray directions (azimuth sectors x polar bands of the view cone) with a safe "
                     "step for every ray of that bin, then the plain map (steeper rays); nearest lookups",
         options=_VOLUME_OPTIONS + (
@@ -277,3 +277,18 @@ def get_kind(name: str) -> Kind:
     if name not in KINDS:
         raise UserError(f"unknown map kind {name!r}; expected one of {', '.join(KINDS)}")
     return KINDS[name]
+
+
+def _option_cell(o: Option) -> str:
+    return f"`{o.name}` {o.default:g}" if isinstance(o.default, float) else f"`{o.name}` {o.default}"
+
+
+def markdown_table() -> str:
+    """The README's map-kind table: kind, what it is, its options (defaults), its kernels, GPU vs CPU tolerance."""
+    rows = ["| kind | what | options (default) | kernels (`wgsl/maps/`) | GPU vs CPU |", "|---|---|---|---|---|"]
+    for k in KINDS.values():
+        options = ", ".join(map(_option_cell, k.options)) or "—"
+        kernels = ", ".join(f"`{f}`" for f in k.kernels)
+        cells = (f"`{k.name}`", k.description, options, kernels, k.tolerance)
+        rows.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")  # a | in a cell is escaped
+    return "\n".join(rows)

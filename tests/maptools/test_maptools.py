@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import cv2
 import numpy as np
 import pytest
@@ -223,3 +225,15 @@ def test_auto_backend_falls_back_to_cpu_with_notice(monkeypatch, capsys):
     assert err.count("\n") == 1 and "CPU" in err
     with pytest.raises(NoAdapterError):
         maptools.generate("normal", MAPS["spike"], backend="gpu")
+
+
+def test_the_map_kind_table_has_a_row_per_kind():
+    """``registry.markdown_table`` (the README's map-kind table): one row per kind, five cells each (a ``|`` in a
+    tolerance is escaped), naming the kernels the kind's cache key hashes."""
+    from maptools.registry import markdown_table
+
+    rows = markdown_table().splitlines()[2:]
+    assert [r.split(" | ")[0] for r in rows] == [f"| `{k}`" for k in KINDS]
+    for row, kind in zip(rows, KINDS.values()):
+        assert len(re.split(r"(?<!\\)\|", row)) == 7, row  # 5 cells between 6 bars
+        assert all(f"`{f}`" in row for f in kind.kernels)
