@@ -55,6 +55,15 @@ class Comparison:
 
 
 @dataclass(frozen=True)
+class Case:
+    """Option values the kind's GPU path is cross-checked on against its CPU twin (tests/maptools), on every test
+    map of at most ``max_texels`` texels (None: all; a bound keeps slow CPU twins to small maps)."""
+
+    options: dict
+    max_texels: int | None = None
+
+
+@dataclass(frozen=True)
 class Kind:
     name: str
     description: str
@@ -66,6 +75,7 @@ class Kind:
     writer: Callable[[Any, Any, str, int], None]  # (file object, result, extension, bits)
     extensions: tuple[str, ...]  # first = default for the batch tool
     check: Callable[[dict], None] = field(default=lambda opts: None)
+    cases: tuple[Case, ...] = ()  # its GPU-vs-CPU cross-checks; every kind has some (tests/maptools)
 
     @property
     def kernels(self) -> tuple[str, ...]:
@@ -203,6 +213,7 @@ KINDS: dict[str, Kind] = {
         cpu=cpu.normal, gpu=gpu.normal, compare=_compare_normal,
         tolerance=f"max |component difference| <= {NORMAL_TOL:g}",
         writer=io.write_normal, extensions=(".png", ".npy"),
+        cases=(*(Case({"border": b}) for b in cpu.BORDERS), Case({"y": "directx", "strength": 4.0})),
     ),
     "complexity": Kind(
         name="complexity",
@@ -218,6 +229,7 @@ KINDS: dict[str, Kind] = {
         cpu=cpu.complexity, gpu=gpu.complexity, compare=_compare_complexity,
         tolerance=f"at most one quantisation level on <= {COMPLEXITY_MAX_FLIPPED:g} of texels (exact on lavapipe)",
         writer=io.write_complexity, extensions=(".png", ".npy"), check=_check_complexity,
+        cases=(Case({"border": "reflect"}), Case({"border": "repeat"})),
     ),
     "maxmip": Kind(
         name="maxmip",
@@ -225,7 +237,7 @@ KINDS: dict[str, Kind] = {
         options=(),
         cpu=cpu.maxmip, gpu=gpu.maxmip, compare=_compare_maxmip,
         tolerance="exact (max is exact)",
-        writer=io.write_maxmip, extensions=(".npz",),
+        writer=io.write_maxmip, extensions=(".npz",), cases=(Case({}),),
     ),
     "distance": Kind(
         name="distance",
@@ -236,6 +248,7 @@ KINDS: dict[str, Kind] = {
         cpu=dist.distance, gpu=gpu.distance, compare=_compare_distance,
         tolerance=f"max |difference| <= {DISTANCE_TOL:g} texel",
         writer=io.write_volume, extensions=(".npy",),
+        cases=(Case({"slices": 4, "height_scale": 0.3}, 2048), Case({"slices": 3, "subcells": 1}, 2048)),
     ),
     "distance_refined": Kind(
         name="distance_refined",
@@ -255,6 +268,7 @@ KINDS: dict[str, Kind] = {
         cpu=rf.distance_refined, gpu=gpu.distance_refined, compare=_compare_refined,
         tolerance=f"|difference| <= max({DISTANCE_TOL:g} texel, one float16 step) on every value",
         writer=io.write_volume, extensions=(".npy",),
+        cases=(Case({"slices": 4, "height_scale": 0.3, "sectors": 2, "bands": 2}, 2048),),
     ),
     "cone": Kind(
         name="cone",
@@ -269,6 +283,7 @@ KINDS: dict[str, Kind] = {
         cpu=cn.cone, gpu=gpu.cone, compare=_compare_cone,
         tolerance=f"relative difference <= {CONE_REL_TOL:g} on all but {CONE_MAX_FLIPPED:g} of texels",
         writer=io.write_cone, extensions=(".npy", ".png"),
+        cases=(Case({"filter": "nearest"}, 2048), Case({"filter": "bilinear"}, 2048)),
     ),
 }
 

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 import maptools
-from maptools import cpu
 from maptools.registry import KINDS
 from tests.conftest import adapter_summary
 from tests.maptools.helpers import adversarial_maps, smooth_tileable
@@ -19,21 +18,28 @@ from wgpuviewer.core.images import read_height
 MAPS = adversarial_maps()
 # -- GPU vs CPU ------------------------------------------------------------------------------------
 
-CASES = ([("normal", {"border": b}) for b in cpu.BORDERS]
-         + [("normal", {"y": "directx", "strength": 4.0})]
-         + [("complexity", {"border": b}) for b in ("reflect", "repeat")]
-         + [("maxmip", {})])
+#: Each kind's declared cross-checks, on every test map within the case's size bound.
+CASES = [(kind, case, name) for kind, k in KINDS.items() for case in k.cases for name in sorted(MAPS)
+         if case.max_texels is None or MAPS[name].size <= case.max_texels]
+
+
+def test_every_kind_declares_valid_cross_checks():
+    for kind, k in KINDS.items():
+        assert k.cases, f"{kind}: no cross-check cases (registry.Kind.cases)"
+        for case in k.cases:
+            k.resolve(case.options)  # names and values the kind accepts
+    assert {kind for kind, _, _ in CASES} == set(KINDS)  # every kind is cross-checked on some test map
 
 
 @pytest.mark.requires_gpu
-@pytest.mark.parametrize("name", sorted(MAPS))
-@pytest.mark.parametrize("kind,opts", CASES, ids=[f"{k}-{'-'.join(map(str, o.values())) or 'default'}" for k, o in CASES])
-def test_gpu_matches_cpu(kind, opts, name):
+@pytest.mark.parametrize("kind,case,name", CASES,
+                         ids=[f"{k}-{'-'.join(map(str, c.options.values())) or 'default'}-{n}" for k, c, n in CASES])
+def test_gpu_matches_cpu(kind, case, name):
     height = MAPS[name]
     k = KINDS[kind]
-    resolved = k.resolve(opts)
-    a = maptools.generate(kind, height, backend="cpu", **opts)
-    b = maptools.generate(kind, height, backend="gpu", **opts)
+    resolved = k.resolve(case.options)
+    a = maptools.generate(kind, height, backend="cpu", **case.options)
+    b = maptools.generate(kind, height, backend="gpu", **case.options)
     c = k.compare(a, b, resolved)
     assert c.ok, (kind, name, c)
     if kind == "normal":
