@@ -7,6 +7,7 @@ import threading
 
 import numpy as np
 import pytest
+import wgpu
 
 from wgpuviewer.core.compute import Compute, KernelError, LimitError, compute_for, source_hash, workgroups
 from wgpuviewer.core.gpu import Gpu
@@ -93,6 +94,10 @@ def test_one_compute_and_one_kernel_per_source_per_device(gpu, scale_wgsl):
     kernel = c.kernel(factor(1.0), scale_wgsl, label="test scale", fix=FIX)
     assert c.kernel(factor(1.0), scale_wgsl, label="test scale", fix=FIX) is kernel
     assert c.kernel(factor(2.0), scale_wgsl, label="test scale", fix=FIX) is not kernel
+    assert c.kernel_of(compose(factor(1.0), scale_wgsl), label="test scale", fix=FIX) is kernel  # same source
+    entries = [[{"binding": 0, "visibility": wgpu.ShaderStage.COMPUTE,
+                 "buffer": {"type": wgpu.BufferBindingType.storage}}]]
+    assert c.layout(entries, "test") is c.layout(entries, "test")
     other = Gpu(gpu.adapter, gpu.device, gpu.features)  # a second Gpu: its own cache and lock
     found: list[Compute] = []
     threads = [threading.Thread(target=lambda: found.append(compute_for(other))) for _ in range(4)]

@@ -1,8 +1,9 @@
 """Compute kernels: compose, compile (errors located at file:line), check limits, bind, dispatch, read back.
 
-``compute_for(gpu)`` is the device's one ``Compute`` (kept in ``Gpu.cache``): its kernels, compiled once per
-device, and a lock for threads that share the device (the maptools batch workers). A ``Kernel`` is one composed
-module (WGSL files and ``Generated`` pieces); its ``source_hash`` names exactly the code the GPU compiles.
+``compute_for(gpu)`` is the device's one ``Compute`` (kept in ``Gpu.cache``): its kernels and pipeline layouts, made
+once per device, behind the device's lock (``Gpu.lock``: threads such as the maptools batch workers share a device).
+A ``Kernel`` is one composed module (WGSL files and ``Generated`` pieces); its ``source_hash`` names exactly the code
+the GPU compiles. Users: maptools, the probe and filter probe, the perspective study's kernels.
 """
 
 from __future__ import annotations
