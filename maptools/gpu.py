@@ -14,12 +14,18 @@ import numpy as np
 from wgpuviewer.core.compute import compute_for
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import get_gpu
+from wgpuviewer.core.wgsl import Module, compose
 
 from . import cpu
 
 #: What a user can do when a kernel fails or does not fit on their adapter.
 FIX = "use --backend cpu"
 _WG = (8, 8, 1)  # @workgroup_size of every kernel
+
+
+def kernel_source(file: str) -> Module:
+    """The composed module of kernel ``file`` (in ``wgsl/maps/``): what the GPU runs and the cache key hashes."""
+    return compose(f"maps/{file}")
 
 
 class MapGpu:
@@ -50,7 +56,7 @@ class MapGpu:
 
     def dispatch(self, encoder, file: str, entry: str, bindings: dict, w: int, h: int, d: int = 1) -> None:
         """One compute pass: ``entry`` of ``file`` over w x h (x d, one workgroup layer per slice) invocations."""
-        kernel = self.compute.kernel(f"maps/{file}", label=f"maptools {file}", fix=FIX)
+        kernel = self.compute.kernel_of(kernel_source(file), label=f"maptools {file}", fix=FIX)
         kernel.dispatch(encoder, entry, bindings, threads=(w, h, d), size=_WG)
 
     def encoder(self, label: str):

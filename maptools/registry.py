@@ -12,7 +12,6 @@ import numpy as np
 
 from wgpuviewer.core.compute import source_hash
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.wgsl import compose
 
 from . import cone as cn
 from . import cpu, gpu, io
@@ -87,7 +86,7 @@ class Kind:
         edited kernel (or a file it includes) never serves a map built by the old one."""
         h = hashlib.sha256()
         for file in self.kernels:
-            h.update(source_hash(compose(f"maps/{file}")).encode())
+            h.update(source_hash(gpu.kernel_source(file)).encode())
         return h.hexdigest()
 
     def resolve(self, options: dict) -> dict:
