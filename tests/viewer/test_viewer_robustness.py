@@ -52,9 +52,9 @@ seen = {"frames": 0, "while_building": 0, "progress": 0, "layout": None, "presse
 def frame():
     if seen["frames"] == 0:
         viewer.press("2")  # normal: its normal map file is fine
-    elif viewer.technique == "normal" and not seen["pressed"]:
-        seen["pressed"].append("3")
-        viewer.press("3")  # pom: needs the height map, whose data is damaged
+    elif viewer.state.halves["A"].technique == "normal" and not seen["pressed"]:
+        seen["pressed"].append("5")
+        viewer.press("5")  # pom: needs the height map, whose data is damaged
     viewer.draw()
     seen["frames"] += 1
     if viewer.build is not None:
@@ -67,7 +67,7 @@ def frame():
 
 viewer.canvas.request_draw(frame)
 viewer.loop.run()
-print(json.dumps({**seen, "technique": viewer.technique, "problems": viewer.problems,
+print(json.dumps({**seen, "technique": viewer.state.halves["A"].technique, "problems": viewer.problems,
                   "problem_shown": "status" in viewer.hud.drawn_panels}))
 """
 
@@ -103,7 +103,7 @@ def test_switching_builds_in_the_background_and_a_bad_texture_keeps_the_previous
 def test_a_scripted_run_with_a_bad_texture_ends_with_one_line_and_exit_2(scene, display, adapter, tmp_path):
     """`--keys` alone makes a scripted run that ends by itself (it used to draw forever); the switch to pom
     fails, the frames go on with basic, and the run reports the problem as its one error line."""
-    result = run([sys.executable, "-m", "wgpuviewer", "view", str(scene), "--keys", "H,3", "--size", "160x100"],
+    result = run([sys.executable, "-m", "wgpuviewer", "view", str(scene), "--keys", "H,5", "--size", "160x100"],
                  display, tmp_path, timeout=120)
     assert result.returncode == 2, result.stderr
     errors = [line for line in result.stderr.splitlines() if line.startswith("wgpuviewer: error:")]

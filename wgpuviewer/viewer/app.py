@@ -12,9 +12,8 @@ Scripted runs (tests, demos): ``frames`` frames, ``keys`` pressed one per frame,
 (HUD included) saved to ``screenshot``; an ERROR logged while drawing makes the run exit 1.
 
 The viewer owns what the user tunes live: the parameters of each technique (``params``, starting from the scene's),
-a relief-depth override per technique (``height_scales``), the texture filter and derivative source of each A/B
-half (``filters``, ``derivative_sources``) and each filter's parameters (``filter_params``); each pass gets them as
-a frozen ``DrawConfig`` (``draw_config``).
+a relief-depth override per technique (``height_scales``), each filter's parameters (``filter_params``) and what each
+A/B half shows (``state``, a ``ViewerState``); each pass gets them as a frozen ``DrawConfig`` (``draw_config``).
 """
 
 from __future__ import annotations
@@ -33,7 +32,7 @@ from wgpuviewer.core.cli import terminal_progress
 from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.core.gpu import get_gpu
 from wgpuviewer.core.io import refuse_directory
-from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, DERIVATIVE_SOURCES, FILTERS, get_filter
+from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, FILTERS, get_filter
 from wgpuviewer.relief.output import save_rgb_png
 from wgpuviewer.relief.renderer import DEPTH_FORMAT, DrawConfig, Renderer
 from wgpuviewer.relief.techniques import get_technique
@@ -41,8 +40,9 @@ from wgpuviewer.scene import Camera, Scene
 
 from .builds import MapBuild
 from .cameras import FlyCamera, OrbitCamera
-from .keys import FLY_KEYS, PRESSED
+from .keys import FLY_KEYS, PRESSED, TECHNIQUE_KEYS
 from .settings import CONFIG_ENV, LIMITS, Settings, save_settings, settings_path
+from .state import Half, ViewerState
 from .stats import FrameStats, GpuTimer
 
 MODES = ("color", "cost", "error")
@@ -105,18 +105,8 @@ class Viewer:
         #: Live parameters per technique (the HUD edits them) and relief-depth overrides per technique.
         self.params = {name: dict(values) for name, values in scene.technique_params.items()}
         self.height_scales: dict[str, float] = {}
-        self.techniques = list(scene.techniques)
-        if technique not in self.techniques:
-            self.techniques.append(technique)
-        self.technique = technique
-        self.technique_b = self.techniques[(self.techniques.index(technique) + 1) % len(self.techniques)]
-        self.active_side = "A"
-        #: Texture filter and derivative source per A/B half, and the live parameters of each filter.
-        self.filters = {"A": filter, "B": filter}
-        self.derivative_sources = {"A": derivatives, "B": derivatives}
-        self.filter_params = {name: f.defaults() for name, f in FILTERS.items()}
-        self.split = False
-        self.split_x = 0.5
+        self.state = ViewerState.start(scene.techniques, technique, filter, derivatives)
+        self.filter_params = {name: f.defaults() for name, f in FILTERS.items()}  # live, per filter
         self.mode = "color"
         self.camera_mode = s.camera_mode
         self.fly = FlyCamera(scene.camera, s.look_sensitivity)
@@ -224,7 +214,7 @@ class Viewer:
     def set_technique(self, name: str, side: str | None = None):
         """Show ``name`` on the active half (or ``side``) once what it needs is built; until then the half keeps
         its technique. A problem (a bad texture file) is shown in the HUD and the technique stays."""
-        side = side or ("B" if self.split and self.active_side == "B" else "A")
+        side = side or self.state.side
         self.wanted[side] = name
         if self.ready(name):
             self._show(side, name)
@@ -243,10 +233,7 @@ class Viewer:
         return not self.renderer.missing(name)
 
     def _show(self, side: str, name: str):
-        if side == "B":
-            self.technique_b = name
-        else:
-            self.technique = name
+        self.state.show(side, name)
         self._update_title()
 
     def _poll_build(self):
@@ -259,7 +246,7 @@ class Viewer:
         if build.error:
             self.problem(build.error)
             if self.wanted.get(build.side) == build.technique:  # not asked for again until a key asks
-                self.wanted[build.side] = self.technique_b if build.side == "B" else self.technique
+                self.wanted[build.side] = self.state.halves[build.side].technique
         elif self.wanted.get(build.side) == build.technique:
             self._show(build.side, build.technique)
         for side, name in self.wanted.items():
@@ -314,7 +301,8 @@ class Viewer:
 
     def screenshot(self, texture) -> Path:
         stamp = time.strftime("%Y%m%d-%H%M%S")
-        name = f"wgpuviewer-{Path(self.scene.path).stem if self.scene.path else 'scene'}-{self.technique}-{stamp}.png"
+        technique = self.state.halves["A"].technique
+        name = f"wgpuviewer-{Path(self.scene.path).stem if self.scene.path else 'scene'}-{technique}-{stamp}.png"
         path = Path.cwd() / name
         save_rgb_png(path, self.read_frame(texture))
         self.message(f"screenshot: {path}")
@@ -327,23 +315,16 @@ class Viewer:
         """The live parameters of technique ``name`` (the dict the HUD edits)."""
         return self.params.setdefault(name, get_technique(name).defaults())
 
-    def draw_config(self, name: str, side: str = "A") -> DrawConfig:
-        """What a pass of technique ``name`` draws in half ``side``: its live parameters and height-scale override,
-        the half's filter with its live parameters and the half's derivative source."""
-        f = self.filters[side]
-        return DrawConfig.of(name, self.technique_params(name), self.height_scales.get(name), filter=f,
-                             filter_params=self.filter_params[f], derivatives=self.derivative_sources[side])
-
-    @property
-    def side(self) -> str:
-        """The half the keys change: B only while the screen is split and B is active."""
-        return "B" if self.split and self.active_side == "B" else "A"
-
-    def filter_label(self, side: str = "A") -> str:
-        return f"{self.filters[side]} ({self.derivative_sources[side]})"
+    def draw_config(self, half: Half) -> DrawConfig:
+        """What a pass of ``half`` draws: its technique's live parameters and height-scale override, its filter with
+        its live parameters and its derivative source."""
+        name = half.technique
+        return DrawConfig.of(name, self.technique_params(name), self.height_scales.get(name), filter=half.filter,
+                             filter_params=self.filter_params[half.filter], derivatives=half.derivatives)
 
     def cost_scale(self) -> float:
-        return get_technique(self.technique).cost_scale(self.technique_params(self.technique))
+        name = self.state.halves["A"].technique
+        return get_technique(name).cost_scale(self.technique_params(name))
 
     def material_height_scales(self) -> str:
         return ", ".join(f"{m.height_scale:g}" for m in self.scene.materials.values())
@@ -359,11 +340,6 @@ class Viewer:
 
     # --- input -------------------------------------------------------------------------------
 
-    def key_for(self, technique: str) -> str:
-        """The number key that selects ``technique`` in this scene (its position: 1..9, then 0)."""
-        index = self.techniques.index(technique)
-        return str((index + 1) % 10) if index < 10 else "←/→"
-
     def press(self, key: str):
         """What a key does (keys.CONTROLS; also used by scripted runs)."""
         control = PRESSED.get(key)
@@ -374,30 +350,22 @@ class Viewer:
     # --- the actions of keys.CONTROLS (each takes the key pressed) -----------------------------------------
 
     def pick_technique(self, key: str):
-        number = int(key) or 10  # keys 1..9, then 0 for the 10th
-        if number <= len(self.techniques):
-            self.set_technique(self.techniques[number - 1])
+        name = self.state.technique_for_key(key)
+        if name is None:
+            self.message(f"{key}: {TECHNIQUE_KEYS[key]} is not in this scene's techniques")
+        else:
+            self.set_technique(name)
 
     def cycle_filter(self, key: str):
-        names = list(FILTERS)
-        side = self.side
-        self.filters[side] = names[(names.index(self.filters[side]) + 1) % len(names)]
-        if not self.split:
-            self.filters["B"] = self.filters["A"]
+        self.state.cycle_filter()
 
     def cycle_derivatives(self, key: str):
-        names = list(DERIVATIVE_SOURCES)
-        side = self.side
-        self.derivative_sources[side] = names[(names.index(self.derivative_sources[side]) + 1) % len(names)]
-        if not get_filter(self.filters[side]).uses_derivatives:
-            self.message(f"{self.filters[side]} reads level 0: the derivative source does not change it")
-        if not self.split:
-            self.derivative_sources["B"] = self.derivative_sources["A"]
+        half = self.state.cycle_derivatives()
+        if not get_filter(half.filter).uses_derivatives:
+            self.message(f"{half.filter} reads level 0: the derivative source does not change it")
 
     def cycle_technique(self, key: str):
-        step = 1 if key == "ArrowRight" else -1
-        current = self.technique_b if self.split and self.active_side == "B" else self.technique
-        self.set_technique(self.techniques[(self.techniques.index(current) + step) % len(self.techniques)])
+        self.set_technique(self.state.next_technique(1 if key == "ArrowRight" else -1))
 
     def reset_camera(self, key: str):
         self.cam.reset()
@@ -412,14 +380,16 @@ class Viewer:
         self.set_mode(MODES[(MODES.index(self.mode) + 1) % len(MODES)])
 
     def toggle_split(self, key: str):
-        self.split = not self.split
-        self.active_side = "A"
-        if self.split and not self.ready(self.technique_b):  # B draws A's technique until its maps are built
-            wanted, self.technique_b = self.technique_b, self.technique
+        state = self.state
+        state.toggle_split()
+        b = state.halves["B"]
+        if state.split and not self.ready(b.technique):  # B draws A's technique until its maps are built
+            wanted = b.technique
+            state.show("B", state.halves["A"].technique)
             self.set_technique(wanted, "B")
 
     def switch_half(self, key: str):
-        self.active_side = "B" if self.active_side == "A" and self.split else "A"
+        self.state.switch_half()
 
     def toggle_camera(self, key: str):
         self.set_camera_mode("fly" if self.camera_mode == "orbit" else "orbit")
@@ -460,7 +430,7 @@ class Viewer:
 
     def _divider_hit(self, x: float) -> bool:
         width = self.canvas.get_logical_size()[0]
-        return self.split and abs(x - self.split_x * width) <= 8
+        return self.state.split and abs(x - self.state.split_x * width) <= 8
 
     def on_pointer(self, event):
         kind = event["event_type"]
@@ -475,7 +445,7 @@ class Viewer:
         elif kind == "pointer_move":
             if self.dragging_divider:
                 width = max(self.canvas.get_logical_size()[0], 1)
-                self.split_x = float(np.clip(event["x"] / width, 0.02, 0.98))
+                self.state.split_x = float(np.clip(event["x"] / width, 0.02, 0.98))
             elif self.drag_from is not None:
                 self.cam.look(event["x"] - self.drag_from[0], event["y"] - self.drag_from[1])
                 self.drag_from = (event["x"], event["y"])
@@ -489,28 +459,28 @@ class Viewer:
             self.move_speed = float(np.clip(self.move_speed * 1.1 ** (-steps), lo, hi))
 
     def _update_title(self):
-        a = f"{self.technique} {self.filter_label('A')}"
-        what = f"{a} | {self.technique_b} {self.filter_label('B')}" if self.split else a
+        what = " | ".join(f"{h.technique} {h.filter} ({h.derivatives})" for _, h in self.state.shown())
         self.canvas.set_title(f"wgpuviewer - {self.scene.name} - {what} ({self.mode})")
 
     # --- frames ------------------------------------------------------------------------------
 
     def _scene_passes(self, w: int, h: int, camera: Camera) -> list:
         """(DrawConfig, scissor) of the passes that draw the scene: one, or the two halves of A/B."""
-        if not self.split:
-            return [(self.draw_config(self.technique), None)]
-        xs = int(np.clip(round(self.split_x * w), 1, w - 1)) if w > 1 else 1
-        return [(self.draw_config(self.technique, "A"), (0, 0, xs, h)),
-                (self.draw_config(self.technique_b, "B"), (xs, 0, w - xs, h))]
+        state = self.state
+        if not state.split:
+            return [(self.draw_config(state.halves["A"]), None)]
+        xs = int(np.clip(round(state.split_x * w), 1, w - 1)) if w > 1 else 1
+        return [(self.draw_config(state.halves["A"]), (0, 0, xs, h)),
+                (self.draw_config(state.halves["B"]), (xs, 0, w - xs, h))]
 
     def _update_error_view(self, w: int, h: int, camera: Camera, now: float):
         """Recompute the error map when what it shows changed (at most ~3 times a second)."""
         from . import error_view
 
         size = error_view.map_size((w, h))
-        halves = [(self.technique, "A"), (self.technique_b, "B")] if self.split else [(self.technique, "A")]
-        draws = [self.draw_config(t, side) for t, side in halves]
-        key = (size, tuple(draws), self.split and round(self.split_x, 3), camera)
+        state = self.state
+        draws = [self.draw_config(half) for _, half in state.shown()]
+        key = (size, tuple(draws), state.split and round(state.split_x, 3), camera)
         if key == self._error_key or (self._error_key is not None and now - self._error_time < 0.3):
             return
         if self._error is None:
@@ -526,9 +496,9 @@ class Viewer:
             return error_view.error_map(self.renderer, draw, size, camera, references[draw.height_scale])
 
         values = error_of(draws[0])
-        if self.split:
+        if state.split:
             right = error_of(draws[1])
-            xs = int(round(self.split_x * size[0]))
+            xs = int(round(state.split_x * size[0]))
             values[:, xs:] = right[:, xs:]
         self.error_texels = error_view.texel_size(self.renderer)
         self._error.upload(values)
@@ -623,7 +593,7 @@ class Viewer:
             move_speed=float(np.clip(self.move_speed, *LIMITS["move_speed"])),
             look_sensitivity=float(np.clip(self.look_sensitivity, lo, hi)),
             show_hud=self.show_hud, show_stats=self.show_stats,
-            last_scene=str(self.scene.path) if self.scene.path else "", last_technique=self.technique,
+            last_scene=str(self.scene.path) if self.scene.path else "", last_technique=self.state.halves["A"].technique,
         )
 
     def run(self, frames: int | None = None, screenshot: str | None = None, keys: list[str] = ()) -> int:

@@ -102,7 +102,7 @@ class Hud:
             self._help_panel(flags, width, height)
         if v.mode in ("cost", "error"):
             self._legend(width, height)
-        if v.split:
+        if v.state.split:
             self._split_labels(width)
         self._status(flags, width, height)
 
@@ -175,18 +175,20 @@ class Hud:
             imgui.set_next_window_pos((width - MARGIN, MARGIN), imgui.Cond_.first_use_ever, (1.0, 0.0))
             imgui.set_next_window_size((min(340, width / 2), 0), imgui.Cond_.first_use_ever)
         imgui.set_next_window_bg_alpha(0.6)
-        title = f"{v.key_for(v.technique)} {v.technique}" + (f" | {v.technique_b}" if v.split else "")
+        state = v.state
+        a = state.halves["A"].technique
+        title = f"{state.key_for(a)} {a}" + (f" | {state.halves['B'].technique}" if state.split else "")
         if not imgui.begin(f"{title}###Technique", None, imgui.WindowFlags_.no_focus_on_appearing)[0]:
             self._record("info")  # collapsed: the title bar alone
             imgui.end()
             return
         imgui.push_item_width(-140)
-        sides = [("A", v.technique)] + ([("B", v.technique_b)] if v.split else [])
-        for tag, name in sides:
+        for tag, half in state.shown():
+            name = half.technique
             t = get_technique(name)
-            prefix = f"{tag}: " if v.split else ""
-            active = v.split and tag == v.active_side
-            imgui.text_colored(YELLOW if active else WHITE, f"{prefix}{v.key_for(t.name)}  {t.name}")
+            prefix = f"{tag}: " if state.split else ""
+            active = state.split and tag == state.active_side
+            imgui.text_colored(YELLOW if active else WHITE, f"{prefix}{state.key_for(t.name)}  {t.name}")
             imgui.push_text_wrap_pos(0.0)
             imgui.text_colored(GREY, t.description)
             imgui.pop_text_wrap_pos()
@@ -194,7 +196,7 @@ class Hud:
             if t.name == "auto":
                 for line in auto_lines(v.renderer, v.technique_params(name)["max_error"]):
                     imgui.text_colored(GREY, line)
-            self._filter(tag if v.split else "A", tag)
+            self._filter(half, tag)
             imgui.separator()
         modes = ("color", "cost", "error")
         for i, mode in enumerate(modes):
@@ -219,22 +221,22 @@ class Hud:
         self._record("info")
         imgui.end()
 
-    def _filter(self, side: str, tag: str) -> None:
+    def _filter(self, half, tag: str) -> None:
         """The half's texture filter (a combo, F cycles it), its derivative source (Shift+F) and parameters."""
         v = self.viewer
         names = list(FILTERS)
-        changed, index = imgui.combo(f"filter (F)##{tag}", names.index(v.filters[side]), names)
+        changed, index = imgui.combo(f"filter (F)##{tag}", names.index(half.filter), names)
         if changed:
-            v.filters[side] = names[index]
+            half.filter = names[index]
         if imgui.is_item_hovered():
-            imgui.set_tooltip(get_filter(v.filters[side]).description)
+            imgui.set_tooltip(get_filter(half.filter).description)
         sources = list(DERIVATIVE_SOURCES)
-        changed, index = imgui.combo(f"derivatives (Shift+F)##{tag}", sources.index(v.derivative_sources[side]), sources)
+        changed, index = imgui.combo(f"derivatives (Shift+F)##{tag}", sources.index(half.derivatives), sources)
         if changed:
-            v.derivative_sources[side] = sources[index]
+            half.derivatives = sources[index]
         if imgui.is_item_hovered():
-            imgui.set_tooltip(DERIVATIVE_SOURCES[v.derivative_sources[side]].description)
-        f = get_filter(v.filters[side])
+            imgui.set_tooltip(DERIVATIVE_SOURCES[half.derivatives].description)
+        f = get_filter(half.filter)
         self._sliders(f.params, v.filter_params[f.name], f"{tag}:{f.name}")
 
     def _help_panel(self, flags, width, height) -> None:
@@ -252,7 +254,7 @@ class Hud:
         v = self.viewer
         draw = imgui.get_foreground_draw_list()
         x0, bar_w, bar_h = 20.0, min(320.0, width - 40.0), 14.0
-        y0 = height - (80.0 if v.split else 50.0)  # above the A/B labels
+        y0 = height - (80.0 if v.state.split else 50.0)  # above the A/B labels
         steps = 32
         # ImGui colours are sRGB-encoded values; its backend linearises them for sRGB targets.
         ramp = linear_to_srgb(heat((np.arange(steps) + 0.5) / steps))
@@ -279,18 +281,18 @@ class Hud:
     def _split_labels(self, width) -> None:
         v = self.viewer
         draw = imgui.get_foreground_draw_list()
-        x = width * v.split_x
+        x = width * v.state.split_x
         white = imgui.color_convert_float4_to_u32(WHITE)
         yellow = imgui.color_convert_float4_to_u32(YELLOW)
         draw.add_line((x, 0), (x, imgui.get_io().display_size[1]), white, 2.0)
         height = imgui.get_io().display_size[1]
-        for tag, name, cx in (("A", v.technique, x / 2), ("B", v.technique_b, (x + width) / 2)):
-            text = f"{tag}: {name} / {v.filter_label(tag)}"
+        for (tag, half), cx in zip(v.state.shown(), (x / 2, (x + width) / 2)):
+            text = f"{tag}: {half.technique} / {half.filter} ({half.derivatives})"
             size = imgui.calc_text_size(text)
             pos = (cx - size.x / 2, height - size.y - 10)
             draw.add_rect_filled((pos[0] - 6, pos[1] - 4), (pos[0] + size.x + 6, pos[1] + size.y + 4),
                                  imgui.color_convert_float4_to_u32((0, 0, 0, 0.6)))
-            draw.add_text(pos, yellow if tag == v.active_side else white, text)
+            draw.add_text(pos, yellow if tag == v.state.active_side else white, text)
         self.drawn_panels.append("split")
 
     def _status(self, flags, width, height) -> None:
@@ -305,8 +307,8 @@ class Hud:
         lines += [(WHITE, m) for m in v.messages[-3:]]
         if not lines:
             return
-        below = v.split or v.mode in ("cost", "error")  # the legend and the A/B labels sit at the bottom
-        bottom = height - (MARGIN if self.compact and not below else 110 if v.split else 80)
+        below = v.state.split or v.mode in ("cost", "error")  # the legend and the A/B labels sit at the bottom
+        bottom = height - (MARGIN if self.compact and not below else 110 if v.state.split else 80)
         imgui.set_next_window_pos((MARGIN, bottom), imgui.Cond_.always, (0.0, 1.0))
         imgui.set_next_window_size_constraints((0, 0), (max(width - 2 * MARGIN, 60), height / 2))
         imgui.set_next_window_bg_alpha(0.7)

@@ -3,12 +3,21 @@ help panel (F1) lists it, ``--keys`` checks against it, and the README's keys ta
 (``markdown_table``; a test compares the two).
 
 Key names are rendercanvas's event keys: Shift+D arrives as "D", so "d" (strafe, held) and "D" (cost view) are
-different keys.
+different keys. The number keys pick techniques by the registry's ``Technique.key`` (the same key in every scene).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+from wgpuviewer.relief.techniques import TECHNIQUES, get_technique
+
+#: Number key -> the technique it picks (techniques whose key is "-" are reached with the arrows).
+TECHNIQUE_KEYS = {t.key: name for name, t in TECHNIQUES.items() if t.key != "-"}
+
+
+def technique_key(name: str) -> str:
+    return get_technique(name).key
 
 
 @dataclass(frozen=True)
@@ -24,7 +33,7 @@ FLY_KEYS = {"w": (0, 0, 1), "s": (0, 0, -1), "a": (-1, 0, 0), "d": (1, 0, 0), "e
 
 CONTROLS = (
     Control("1–9, 0", "pick the technique (in A/B: of the active half); 0 is the tenth",
-            tuple("1234567890"), "pick_technique"),
+            tuple(TECHNIQUE_KEYS), "pick_technique"),
     Control("←/→", "previous / next technique (also past the tenth)", ("ArrowLeft", "ArrowRight"), "cycle_technique"),
     Control("W A S D, Q E", "fly forward/left/back/right, down/up (while held)", tuple(FLY_KEYS)),
     Control("left drag", "look around (fly) / orbit (orbit camera); drags the A/B divider"),

@@ -1,0 +1,88 @@
+"""The viewer's state without a window: technique keys from the registry, filter and derivative cycling on the active
+half, the A/B split; and the key table stays the one source of the technique keys."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS
+from wgpuviewer.relief.techniques import TECHNIQUES
+from wgpuviewer.viewer.keys import PRESSED, TECHNIQUE_KEYS
+from wgpuviewer.viewer.state import Half, ViewerState
+
+FIRST_FILTER, SECOND_FILTER = list(FILTERS)[:2]
+FIRST_SOURCE, SECOND_SOURCE = list(DERIVATIVE_SOURCES)[:2]
+
+
+def state(techniques=("basic", "normal", "pom"), technique="basic") -> ViewerState:
+    return ViewerState.start(techniques, technique, FIRST_FILTER, FIRST_SOURCE)
+
+
+def test_the_state_needs_neither_wgpu_nor_a_toolkit():
+    code = ("import sys; import wgpuviewer.viewer.state; "
+            "print(sorted(m for m in ('wgpu', 'rendercanvas', 'glfw', 'imgui_bundle') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
+
+
+def test_start_shows_the_technique_on_a_and_the_next_one_on_b():
+    s = state(technique="pom")
+    assert s.halves == {"A": Half("pom", FIRST_FILTER, FIRST_SOURCE), "B": Half("basic", FIRST_FILTER, FIRST_SOURCE)}
+    assert not s.split and s.side == "A" and [side for side, _ in s.shown()] == ["A"]
+    assert state(technique="relief").techniques == ["basic", "normal", "pom", "relief"]  # not listed: added last
+
+
+def test_number_keys_pick_by_the_registry_key_in_every_scene():
+    assert set(TECHNIQUE_KEYS) == set("1234567890")
+    for key, name in TECHNIQUE_KEYS.items():
+        assert TECHNIQUES[name].key == key and PRESSED[key].action == "pick_technique"
+    s = state(("basic", "pom", "relief"))
+    assert s.technique_for_key(TECHNIQUES["pom"].key) == "pom"  # pom is second here, its key is still its own
+    assert s.technique_for_key(TECHNIQUES["relief"].key) == "relief"
+    assert s.technique_for_key(TECHNIQUES["normal"].key) is None  # not in this scene
+    assert s.key_for("pom") == TECHNIQUES["pom"].key
+    keyless = next(name for name, t in TECHNIQUES.items() if t.key == "-")
+    assert s.key_for(keyless) == "←/→"
+
+
+def test_arrows_step_through_the_scene_from_the_active_half():
+    s = state(("basic", "normal", "pom"), "basic")
+    assert s.next_technique(1) == "normal" and s.next_technique(-1) == "pom"
+    s.toggle_split()
+    s.switch_half()  # B (normal) is active
+    assert s.next_technique(1) == "pom"
+
+
+def test_filter_and_derivatives_cycle_on_the_active_half_and_b_follows_a_while_unsplit():
+    s = state()
+    assert s.cycle_filter() is s.halves["A"]
+    assert s.halves["A"].filter == s.halves["B"].filter == SECOND_FILTER
+    s.cycle_derivatives()
+    assert s.halves["A"].derivatives == s.halves["B"].derivatives == SECOND_SOURCE
+    for _ in FILTERS:  # a full cycle comes back
+        s.cycle_filter()
+    assert s.halves["A"].filter == SECOND_FILTER
+
+    s.toggle_split()
+    s.switch_half()
+    assert s.side == "B"
+    s.cycle_filter()
+    s.cycle_derivatives()
+    assert s.halves["A"] == Half("basic", SECOND_FILTER, SECOND_SOURCE)
+    assert s.halves["B"].filter != SECOND_FILTER and s.halves["B"].derivatives != SECOND_SOURCE
+
+
+def test_split_on_and_off():
+    s = state()
+    s.switch_half()  # unsplit: there is only A
+    assert s.side == "A" and s.active_side == "A"
+    s.toggle_split()
+    assert s.split and [side for side, _ in s.shown()] == ["A", "B"]
+    s.switch_half()
+    assert s.side == "B" and s.active is s.halves["B"]
+    s.show("B", "pom")
+    s.toggle_split()  # joined: the keys change A, B keeps what it showed
+    assert not s.split and s.side == "A" and s.halves["B"].technique == "pom"
+    s.toggle_split()
+    assert s.active_side == "A"  # a new split starts on A

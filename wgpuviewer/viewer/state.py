@@ -1,0 +1,105 @@
+"""What the viewer shows, without a window or a GPU: the scene's techniques, the two halves of the A/B split (each a
+``Half``: technique, texture filter, derivative source), which half the keys change, and the divider.
+
+The key actions that only change this state are transitions here, so tests drive them directly; whatever needs maps
+built or a window (switching to a technique whose maps are missing, vsync, fullscreen) stays in the app.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS
+
+from .keys import TECHNIQUE_KEYS, technique_key
+
+SIDES = ("A", "B")
+
+
+@dataclass
+class Half:
+    """One side of the A/B split (the whole screen while it is not split: half A)."""
+
+    technique: str
+    filter: str
+    derivatives: str
+
+
+def _next(names: list[str], current: str, step: int = 1) -> str:
+    return names[(names.index(current) + step) % len(names)]
+
+
+@dataclass
+class ViewerState:
+    techniques: list[str]  # the scene's, in its order (Left/Right step through them)
+    halves: dict[str, Half] = field(default_factory=dict)  # "A" and "B"
+    split: bool = False
+    active_side: str = "A"
+    split_x: float = 0.5  # the divider, as a fraction of the width
+
+    @classmethod
+    def start(cls, techniques, technique: str, filter: str, derivatives: str) -> ViewerState:
+        """A shows ``technique``; B shows the scene's next one, both with the same filter and derivative source."""
+        names = list(techniques)
+        if technique not in names:
+            names.append(technique)
+        return cls(names, {"A": Half(technique, filter, derivatives),
+                           "B": Half(_next(names, technique), filter, derivatives)})
+
+    @property
+    def side(self) -> str:
+        """The half the keys change: B only while the screen is split and B is active."""
+        return "B" if self.split and self.active_side == "B" else "A"
+
+    @property
+    def active(self) -> Half:
+        return self.halves[self.side]
+
+    def shown(self) -> list[tuple[str, Half]]:
+        """The halves on screen: A alone, or A and B while split."""
+        return [(side, self.halves[side]) for side in (SIDES if self.split else SIDES[:1])]
+
+    def show(self, side: str, technique: str) -> None:
+        self.halves[side].technique = technique
+
+    def technique_for_key(self, key: str) -> str | None:
+        """The scene's technique that number key ``key`` selects (the registry's ``Technique.key``); None when the
+        key's technique is not in this scene."""
+        name = TECHNIQUE_KEYS.get(key)
+        return name if name in self.techniques else None
+
+    def key_for(self, technique: str) -> str:
+        """The key that selects ``technique``: its number key, or the arrows for one without."""
+        key = technique_key(technique)
+        return key if key in TECHNIQUE_KEYS else "←/→"
+
+    def next_technique(self, step: int) -> str:
+        """The scene's technique ``step`` places after the active half's (wrapping around)."""
+        return _next(self.techniques, self.active.technique, step)
+
+    def _mirror(self) -> None:
+        # Unsplit, B follows A, so that splitting starts by comparing techniques under the same filter.
+        if not self.split:
+            self.halves["B"].filter, self.halves["B"].derivatives = self.halves["A"].filter, self.halves["A"].derivatives
+
+    def cycle_filter(self) -> Half:
+        """The active half's next texture filter; returns that half."""
+        half = self.active
+        half.filter = _next(list(FILTERS), half.filter)
+        self._mirror()
+        return half
+
+    def cycle_derivatives(self) -> Half:
+        """The active half's next derivative source; returns that half."""
+        half = self.active
+        half.derivatives = _next(list(DERIVATIVE_SOURCES), half.derivatives)
+        self._mirror()
+        return half
+
+    def toggle_split(self) -> None:
+        """Split or join the screen; either way the keys change half A next."""
+        self.split = not self.split
+        self.active_side = "A"
+
+    def switch_half(self) -> None:
+        self.active_side = "B" if self.active_side == "A" and self.split else "A"
