@@ -199,3 +199,13 @@ def test_scripted_run_errors_end_the_run(display, tmp_path, adapter):
     assert result.returncode == 2 and "cannot write" in result.stderr and "Traceback" not in result.stderr
     result = subprocess.run([*base, "--keys", "Nope"], capture_output=True, text=True, timeout=120, env=env)
     assert result.returncode == 2 and "--keys: unknown key 'Nope'" in result.stderr
+
+
+def test_vsync_and_fullscreen_go_through_the_window_adapter(runs):
+    """V and F11 reach the surface and the toolkit (rendercanvas hooks live in viewer.window): each says what it did,
+    nothing reports a hook that moved, and the frames go on."""
+    run = runs("window_hooks", "V,F11,F11,V")
+    lines = run.stderr.splitlines()
+    assert [line for line in lines if line.startswith("vsync ")] == ["vsync on", "vsync off"]
+    assert not [line for line in lines if line.startswith(("vsync:", "fullscreen:"))], run.stderr
+    assert run.image.std() > 0  # the scene, not a blank frame

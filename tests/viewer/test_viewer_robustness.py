@@ -63,10 +63,10 @@ def frame():
         seen["progress"] += 1
         seen["layout"] = viewer.hud.rects
     if (seen["pressed"] and viewer.build is None) or seen["frames"] > 3000:
-        viewer.canvas.close()
+        viewer.window.close()
 
-viewer.canvas.request_draw(frame)
-viewer.loop.run()
+viewer.window.request_draw(frame)
+viewer.window.run()
 print(json.dumps({**seen, "technique": viewer.state.halves["A"].technique, "problems": viewer.problems,
                   "problem_shown": "status" in viewer.hud.drawn_panels}))
 """

@@ -1,4 +1,4 @@
-"""The interactive window: rendercanvas (glfw by default, Qt on request) on any wgpu backend.
+"""The interactive viewer on any wgpu backend, in a rendercanvas window (``window``: glfw by default, Qt on request).
 
 Compare relief-mapping techniques live: number keys and Left/Right switch techniques, F the texture filter
 (Shift+F its derivative source), B splits the screen between two techniques or filters (drag the divider),
@@ -44,30 +44,9 @@ from .keys import FLY_KEYS, PRESSED, TECHNIQUE_KEYS
 from .settings import CONFIG_ENV, LIMITS, Settings, save_settings, settings_path
 from .state import Half, ViewerState
 from .stats import FrameStats, GpuTimer
+from .window import Window, toolkit
 
 MODES = ("color", "cost", "error")
-
-
-def _canvas_class(gui: str):
-    try:
-        if gui == "glfw":
-            from rendercanvas.glfw import RenderCanvas, loop
-        elif gui == "qt":
-            import importlib
-
-            for qt in ("PySide6", "PyQt6", "PySide2", "PyQt5"):  # rendercanvas.qt uses the one imported
-                try:
-                    importlib.import_module(f"{qt}.QtWidgets")
-                    break
-                except ImportError:
-                    continue
-            from rendercanvas.qt import RenderCanvas, loop
-        else:
-            from rendercanvas.auto import RenderCanvas, loop
-    except ImportError as error:
-        fix = {"glfw": "pip install 'wgpuviewer[window]'", "qt": "pip install PySide6"}.get(gui, "pip install glfw")
-        raise UserError(f"--gui {gui}: the window toolkit is missing ({error}); install it with: {fix}") from None
-    return RenderCanvas, loop
 
 
 class Viewer:
@@ -86,8 +65,7 @@ class Viewer:
         filter: str = DEFAULT_FILTER,
         derivatives: str = DEFAULT_DERIVATIVES,
     ):
-        RenderCanvas, self.loop = _canvas_class(gui)
-        self.gui = gui
+        toolkit(gui)  # a missing toolkit fails before any map is built
         self.settings = settings or Settings()
         s = self.settings
         self.scene = scene
@@ -123,14 +101,8 @@ class Viewer:
         self.dragging_divider = False
         self.frame_size = (0, 0)
         self.scripted = scripted
-        width, height = size or (s.width, s.height)
-        self.canvas = RenderCanvas(
-            title="wgpuviewer", size=(width, height), update_mode="continuous",
-            max_fps=1000 if scripted else 240, vsync=self.vsync,
-        )
-        self.context = self.canvas.get_wgpu_context()
-        self.format = self.context.get_preferred_format(self.gpu.adapter)
-        self._configure()
+        self.window = Window(gui, self.gpu, size or (s.width, s.height), scripted=scripted, vsync=self.vsync)
+        self.format = self.window.format
         self._depth = None
         self._last_time = time.perf_counter()
         self.stats = FrameStats()
@@ -147,17 +119,13 @@ class Viewer:
         self.hud = hud_module.Hud(self) if hud and hud_module.AVAILABLE else None
         if hud and self.hud is None:
             self.message("no HUD: install imgui-bundle (pip install 'wgpuviewer[window]')")
-        self.canvas.add_event_handler(self.on_key_down, "key_down")
-        self.canvas.add_event_handler(self.on_key_up, "key_up")
-        self.canvas.add_event_handler(self.on_pointer, "pointer_down", "pointer_up", "pointer_move")
-        self.canvas.add_event_handler(self.on_wheel, "wheel")
+        self.window.on(self.on_key_down, "key_down")
+        self.window.on(self.on_key_up, "key_up")
+        self.window.on(self.on_pointer, "pointer_down", "pointer_up", "pointer_move")
+        self.window.on(self.on_wheel, "wheel")
         if s.fullscreen:
             self.set_fullscreen(True)
         self._update_title()
-
-    def _configure(self):
-        # COPY_SRC lets scripted runs and P read back the frame just drawn.
-        self.context.configure(device=self.gpu.device, format=self.format, usage="RENDER_ATTACHMENT|COPY_SRC")
 
     # --- state changes (keys and HUD) ----------------------------------------------------------
 
@@ -266,38 +234,18 @@ class Viewer:
         return None
 
     def set_vsync(self, on: bool):
-        """Vsync picks the surface present mode (fifo vs immediate/mailbox); it needs a reconfigure."""
         self.vsync = bool(on)
-        try:
-            self.canvas._vsync = self.vsync  # read by rendercanvas when it creates the surface
-            inner = getattr(self.context, "_wgpu_context", None)
-            if inner is not None:
-                inner._present_info["vsync"] = self.vsync
-            self._configure()
-        except Exception as error:  # noqa: BLE001 -- private hooks of rendercanvas/wgpu may move
-            self.message(f"vsync: could not change the present mode ({error})")
+        problem = self.window.set_vsync(self.vsync)
+        if problem:
+            self.message(f"vsync: {problem}")
         self.message(f"vsync {'on' if self.vsync else 'off'}")
 
     def set_fullscreen(self, on: bool):
-        try:
-            if self.gui == "qt" or hasattr(self.canvas, "showFullScreen"):
-                self.canvas.showFullScreen() if on else self.canvas.showNormal()
-            else:
-                import glfw
-
-                window = self.canvas._window
-                if on:
-                    self._windowed = (glfw.get_window_pos(window), glfw.get_window_size(window))
-                    monitor = glfw.get_primary_monitor()
-                    mode = glfw.get_video_mode(monitor)
-                    glfw.set_window_monitor(window, monitor, 0, 0, mode.size.width, mode.size.height,
-                                            mode.refresh_rate)
-                else:
-                    (x, y), (w, h) = getattr(self, "_windowed", ((100, 100), (self.settings.width, self.settings.height)))
-                    glfw.set_window_monitor(window, None, x, y, w, h, 0)
+        problem = self.window.set_fullscreen(on)
+        if problem:
+            self.message(f"fullscreen: {problem}")
+        else:
             self.fullscreen = on
-        except Exception as error:  # noqa: BLE001 -- e.g. no monitor, or another toolkit
-            self.message(f"fullscreen: not available here ({error})")
 
     def screenshot(self, texture) -> Path:
         stamp = time.strftime("%Y%m%d-%H%M%S")
@@ -416,7 +364,7 @@ class Viewer:
         self.reloader.reload()
 
     def quit(self, key: str):
-        self.canvas.close()
+        self.window.close()
 
     def on_key_down(self, event):
         key = event["key"]
@@ -429,7 +377,7 @@ class Viewer:
         self.held.discard(event["key"].lower())  # Shift released first: "D" ends the held "d"
 
     def _divider_hit(self, x: float) -> bool:
-        width = self.canvas.get_logical_size()[0]
+        width = self.window.logical_size()[0]
         return self.state.split and abs(x - self.state.split_x * width) <= 8
 
     def on_pointer(self, event):
@@ -444,7 +392,7 @@ class Viewer:
             self.dragging_divider = False
         elif kind == "pointer_move":
             if self.dragging_divider:
-                width = max(self.canvas.get_logical_size()[0], 1)
+                width = max(self.window.logical_size()[0], 1)
                 self.state.split_x = float(np.clip(event["x"] / width, 0.02, 0.98))
             elif self.drag_from is not None:
                 self.cam.look(event["x"] - self.drag_from[0], event["y"] - self.drag_from[1])
@@ -460,7 +408,7 @@ class Viewer:
 
     def _update_title(self):
         what = " | ".join(f"{h.technique} {h.filter} ({h.derivatives})" for _, h in self.state.shown())
-        self.canvas.set_title(f"wgpuviewer - {self.scene.name} - {what} ({self.mode})")
+        self.window.set_title(f"wgpuviewer - {self.scene.name} - {what} ({self.mode})")
 
     # --- frames ------------------------------------------------------------------------------
 
@@ -522,7 +470,7 @@ class Viewer:
         if self.held and self.camera_mode == "fly":
             step = np.sum([FLY_KEYS[k] for k in self.held], axis=0) * self.move_speed * dt
             self.fly.move(*step)
-        texture = self.context.get_current_texture()
+        texture = self.window.current_texture()
         w, h = texture.size[:2]
         if w < 1 or h < 1:
             raise wgpu.DrawCancelled("zero-sized frame")
@@ -584,7 +532,7 @@ class Viewer:
         """What to persist: window size (when not fullscreen), camera and UI choices, scene, technique."""
         s = self.settings
         if not self.fullscreen:
-            lw, lh = self.canvas.get_logical_size()
+            lw, lh = self.window.logical_size()
             if lw >= LIMITS["width"][0] and lh >= LIMITS["height"][0]:
                 s = replace(s, width=int(round(lw)), height=int(round(lh)))
         lo, hi = LIMITS["look_sensitivity"]
@@ -615,17 +563,17 @@ class Viewer:
                     if screenshot:
                         save_rgb_png(Path(screenshot), self.read_frame(texture))
                         print(screenshot)
-                    self.canvas.close()
+                    self.window.close()
             except BaseException as error:
                 # rendercanvas would log it and call us again forever: stop, and report it after the loop.
                 if frames is None and not isinstance(error, UserError):
                     raise
                 state["error"] = error
-                self.canvas.close()
+                self.window.close()
 
-        self.canvas.request_draw(frame)
+        self.window.request_draw(frame)
         try:
-            self.loop.run()
+            self.window.run()
         finally:
             for name in ("wgpu", "rendercanvas"):
                 logging.getLogger(name).removeHandler(errors)

@@ -52,7 +52,7 @@ def auto_lines(renderer, max_error: float) -> list[str]:
 class Hud:
     def __init__(self, viewer):
         self.viewer = viewer
-        self.imgui = ImguiRenderer(viewer.gpu.device, viewer.canvas)
+        self.imgui = ImguiRenderer(viewer.gpu.device, viewer.window.canvas)
         io = imgui.get_io()
         io.set_ini_filename("")  # window positions are not persisted next to the user's cwd
         self.drawn_panels: list[str] = []  # what the last frame showed (tests, debugging)
@@ -62,10 +62,10 @@ class Hud:
         """Build this frame's UI and record it into ``view``."""
         renderer = self.imgui
         imgui.set_current_context(renderer.imgui_context)
-        context = renderer._canvas_context
-        ratio = context.pixel_ratio
+        window = self.viewer.window
+        ratio = window.pixel_ratio()
         renderer.backend.io.display_framebuffer_scale = (ratio, ratio)
-        renderer.backend.io.display_size = context.logical_size
+        renderer.backend.io.display_size = window.logical_size()
         imgui.new_frame()
         try:
             self.build()
