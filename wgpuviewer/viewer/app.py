@@ -8,8 +8,7 @@ A HUD (imgui) shows FPS/frame/GPU time, the technique's description and live par
 keys (F1). Edited WGSL files are recompiled on the fly. Settings persist between sessions
 (``settings``). ``keys.CONTROLS`` lists every key.
 
-Scripted runs (tests, demos): ``frames`` frames, ``keys`` pressed one per frame, the last frame
-(HUD included) saved to ``screenshot``; an ERROR logged while drawing makes the run exit 1.
+Runs, interactive or scripted (``--frames``, ``--keys``, ``--screenshot``), go through ``runner``.
 
 The viewer owns what the user tunes live: the parameters of each technique (``params``, starting from the scene's),
 a relief-depth override per technique (``height_scales``), each filter's parameters (``filter_params``) and what each
@@ -18,7 +17,6 @@ A/B half shows (``state``, a ``ViewerState``); each pass gets them as a frozen `
 
 from __future__ import annotations
 
-import logging
 import sys
 import time
 from dataclasses import replace
@@ -31,13 +29,13 @@ from wgpuviewer.camera import normalize
 from wgpuviewer.core.cli import terminal_progress
 from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.core.gpu import get_gpu
-from wgpuviewer.core.io import refuse_directory
 from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, FILTERS, get_filter
 from wgpuviewer.relief.output import save_rgb_png
 from wgpuviewer.relief.renderer import DEPTH_FORMAT, DrawConfig, Renderer
 from wgpuviewer.relief.techniques import get_technique
 from wgpuviewer.scene import Camera, Scene
 
+from . import runner
 from .builds import MapBuild
 from .cameras import FlyCamera, OrbitCamera
 from .keys import FLY_KEYS, PRESSED, TECHNIQUE_KEYS
@@ -544,55 +542,6 @@ class Viewer:
             last_scene=str(self.scene.path) if self.scene.path else "", last_technique=self.state.halves["A"].technique,
         )
 
-    def run(self, frames: int | None = None, screenshot: str | None = None, keys: list[str] = ()) -> int:
-        state = {"frame": 0}
-        pending = list(keys)
-        # rendercanvas only logs a failing draw and shows the previous frame: a scripted run must
-        # notice, or a broken shader would pass as a green test.
-        errors = _ErrorLogCounter()
-        for name in ("wgpu", "rendercanvas"):
-            logging.getLogger(name).addHandler(errors)
-
-        def frame():
-            try:
-                if pending:
-                    self.press(pending.pop(0))
-                texture = self.draw()
-                state["frame"] += 1
-                if frames is not None and state["frame"] >= frames:
-                    if screenshot:
-                        save_rgb_png(Path(screenshot), self.read_frame(texture))
-                        print(screenshot)
-                    self.window.close()
-            except BaseException as error:
-                # rendercanvas would log it and call us again forever: stop, and report it after the loop.
-                if frames is None and not isinstance(error, UserError):
-                    raise
-                state["error"] = error
-                self.window.close()
-
-        self.window.request_draw(frame)
-        try:
-            self.window.run()
-        finally:
-            for name in ("wgpu", "rendercanvas"):
-                logging.getLogger(name).removeHandler(errors)
-        if "error" in state:
-            raise state["error"]
-        if frames is not None and errors.count:
-            print(f"wgpuviewer: error: {errors.count} error(s) logged while drawing", file=sys.stderr)
-            return 1
-        return 0
-
-
-class _ErrorLogCounter(logging.Handler):
-    def __init__(self):
-        super().__init__(level=logging.ERROR)
-        self.count = 0
-
-    def emit(self, record):
-        self.count += 1
-
 
 def save_session(settings: Settings) -> None:
     """Save the settings at the end of a session; a folder that cannot be written is a warning naming it and
@@ -612,24 +561,14 @@ def run_viewer(
     filter: str = DEFAULT_FILTER, derivatives: str = DEFAULT_DERIVATIVES,
 ) -> int:
     """Open the window. Interactive runs save the settings on exit (``save``); scripted ones don't."""
-    if frames is not None and frames < 1:
-        raise UserError(f"--frames {frames}: expected a positive number of frames")
-    if (screenshot or keys) and frames is None:
-        frames = len(keys) + 3  # a screenshot or keys to press imply a scripted run, which ends by itself
-    if screenshot:
-        refuse_directory(screenshot, "shot.png")
-        if not screenshot.lower().endswith(".png"):
-            raise UserError(f"--screenshot {screenshot}: expected a .png path")
-    unknown = [k for k in keys if k not in PRESSED]
-    if unknown:
-        raise UserError(f"--keys: unknown key {unknown[0]!r}; known: {', '.join(sorted(PRESSED))}")
+    frames = runner.scripted_frames(frames, screenshot, keys)
     scripted = frames is not None
     viewer = Viewer(scene, technique, backend, gui=gui, settings=settings, size=size, scripted=scripted,
                     filter=filter, derivatives=derivatives)
     if not scripted:
         print("keys: F1 help, 1-9 technique, F filter, B A/B split, Shift+D cost, Shift+E error, H hide UI, Esc quit",
               file=sys.stderr)
-    code = viewer.run(frames, screenshot, keys)
+    code = runner.run(viewer, frames, screenshot, keys)
     if save if save is not None else not scripted:
         save_session(viewer.current_settings())
     if code == 0 and scripted and viewer.problems:  # a scripted run reports what the HUD showed

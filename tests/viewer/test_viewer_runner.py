@@ -1,0 +1,93 @@
+"""The run loop without a window: a stand-in window that, like a toolkit, may ask for frames after it closed."""
+
+from __future__ import annotations
+
+import logging
+
+import pytest
+
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.viewer import runner
+
+
+class ToolkitWindow:
+    """Calls the draw function ``asks`` times, whether or not it closed meanwhile."""
+
+    def __init__(self, asks: int):
+        self.asks, self.closed, self.draw = asks, False, None
+
+    def request_draw(self, draw):
+        self.draw = draw
+
+    def run(self):
+        for _ in range(self.asks):
+            self.draw()
+
+    def close(self):
+        self.closed = True
+
+
+class FakeViewer:
+    def __init__(self, window, fail_at: int | None = None, log_error_at: int | None = None):
+        self.window, self.fail_at, self.log_error_at = window, fail_at, log_error_at
+        self.events: list[str] = []
+
+    def press(self, key):
+        self.events.append(f"press {key}")
+
+    def draw(self):
+        frame = sum(e == "draw" for e in self.events)
+        self.events.append("draw")
+        if frame == self.fail_at:
+            raise UserError("cannot write the frame")
+        if frame == self.log_error_at:
+            logging.getLogger(runner.LOGGERS[0]).error("a draw failed")
+        return "texture"
+
+
+def test_a_scripted_run_presses_one_key_per_frame_and_stops_drawing_once_closed():
+    window = ToolkitWindow(asks=6)
+    viewer = FakeViewer(window)
+    assert runner.run(viewer, frames=3, keys=["b", "f"]) == 0
+    assert viewer.events == ["press b", "draw", "press f", "draw", "draw"]
+    assert window.closed
+
+
+def test_an_error_in_a_frame_ends_a_scripted_run_and_is_raised_after_the_loop():
+    window = ToolkitWindow(asks=5)
+    viewer = FakeViewer(window, fail_at=1)
+    with pytest.raises(UserError, match="cannot write"):
+        runner.run(viewer, frames=4)
+    assert viewer.events == ["draw", "draw"] and window.closed
+
+
+@pytest.fixture
+def own_logger(monkeypatch):
+    """The runner watches a logger of its own here (conftest fails any test that logs an ERROR on wgpu's)."""
+    monkeypatch.setattr(runner, "LOGGERS", ("tests.viewer.runner",))
+
+
+def test_an_error_logged_while_drawing_fails_a_scripted_run(own_logger, capsys):
+    viewer = FakeViewer(ToolkitWindow(asks=3), log_error_at=0)
+    assert runner.run(viewer, frames=2) == 1
+    assert "1 error(s) logged while drawing" in capsys.readouterr().err
+
+
+def test_an_interactive_run_draws_until_closed(own_logger):
+    window = ToolkitWindow(asks=4)
+    viewer = FakeViewer(window, log_error_at=0)
+    assert runner.run(viewer) == 0  # logged errors fail scripted runs only
+    assert viewer.events.count("draw") == 4 and not window.closed
+
+
+def test_the_script_is_checked_before_any_window_opens(tmp_path):
+    assert runner.scripted_frames(None, None, ()) is None
+    assert runner.scripted_frames(None, None, ["b", "f"]) == 5  # keys imply a run that ends by itself
+    assert runner.scripted_frames(None, str(tmp_path / "a.png"), ()) == 3
+    assert runner.scripted_frames(7, None, ["b"]) == 7
+    with pytest.raises(UserError, match="--frames 0: expected a positive"):
+        runner.scripted_frames(0, None, ())
+    with pytest.raises(UserError, match="--screenshot .*a.jpg: expected a .png path"):
+        runner.scripted_frames(None, str(tmp_path / "a.jpg"), ())
+    with pytest.raises(UserError, match="--keys: unknown key 'Nope'"):
+        runner.scripted_frames(None, None, ["b", "Nope"])

@@ -1,0 +1,91 @@
+"""The viewer's run loop, interactive or scripted.
+
+Scripted runs (tests, demos): ``frames`` frames, ``keys`` pressed one per frame, the last frame (HUD included) saved
+to ``screenshot``; an ERROR logged while drawing makes the run exit 1, an error inside a frame ends it (exit 2 for a
+UserError). Once the window closes no frame is drawn, even when the toolkit asks for one more.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+from pathlib import Path
+
+from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.io import refuse_directory
+from wgpuviewer.relief.output import save_rgb_png
+
+from .keys import PRESSED
+
+#: The loggers whose ERRORs fail a scripted run.
+LOGGERS = ("wgpu", "rendercanvas")
+
+
+def scripted_frames(frames: int | None, screenshot: str | None, keys) -> int | None:
+    """How many frames a run draws (None: until the window is closed), after checking the script's arguments."""
+    if frames is not None and frames < 1:
+        raise UserError(f"--frames {frames}: expected a positive number of frames")
+    if (screenshot or keys) and frames is None:
+        frames = len(keys) + 3  # a screenshot or keys to press imply a scripted run, which ends by itself
+    if screenshot:
+        refuse_directory(screenshot, "shot.png")
+        if not screenshot.lower().endswith(".png"):
+            raise UserError(f"--screenshot {screenshot}: expected a .png path")
+    unknown = [k for k in keys if k not in PRESSED]
+    if unknown:
+        raise UserError(f"--keys: unknown key {unknown[0]!r}; known: {', '.join(sorted(PRESSED))}")
+    return frames
+
+
+class _ErrorLogCounter(logging.Handler):
+    def __init__(self):
+        super().__init__(level=logging.ERROR)
+        self.count = 0
+
+    def emit(self, record):
+        self.count += 1
+
+
+def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=()) -> int:
+    """Draw ``viewer`` in its window until it closes (interactive: ``frames`` None) or for ``frames`` frames."""
+    state = {"frame": 0}
+    pending = list(keys)
+    window = viewer.window
+    # rendercanvas only logs a failing draw and shows the previous frame: a scripted run must
+    # notice, or a broken shader would pass as a green test.
+    errors = _ErrorLogCounter()
+    for name in LOGGERS:
+        logging.getLogger(name).addHandler(errors)
+
+    def frame():
+        if window.closed:  # the toolkit may ask once more after close: its surface is gone
+            return
+        try:
+            if pending:
+                viewer.press(pending.pop(0))
+            texture = viewer.draw()
+            state["frame"] += 1
+            if frames is not None and state["frame"] >= frames:
+                if screenshot:
+                    save_rgb_png(Path(screenshot), viewer.read_frame(texture))
+                    print(screenshot)
+                window.close()
+        except BaseException as error:
+            # rendercanvas would log it and call us again forever: stop, and report it after the loop.
+            if frames is None and not isinstance(error, UserError):
+                raise
+            state["error"] = error
+            window.close()
+
+    window.request_draw(frame)
+    try:
+        window.run()
+    finally:
+        for name in LOGGERS:
+            logging.getLogger(name).removeHandler(errors)
+    if "error" in state:
+        raise state["error"]
+    if frames is not None and errors.count:
+        print(f"wgpuviewer: error: {errors.count} error(s) logged while drawing", file=sys.stderr)
+        return 1
+    return 0
