@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from wgpuviewer.core.compute import compute_for
-from wgpuviewer.core.structs import Struct, array, f32_literal, range_constants
+from wgpuviewer.core.structs import Struct, array, f32_literal, f32_uniform, range_constants
 from wgpuviewer.core.wgsl import compose
 
 LIGHT = Struct("Light", [("position", "vec3f"), ("radius", "f32"), ("color", "vec3f")])
@@ -109,6 +109,19 @@ def test_pack_unpack_round_trip():
     assert offsets[7] == 5.0 and np.frombuffer(data, np.int32)[12] == -9  # w at byte 28, k at byte 48
     with pytest.raises(ValueError, match="hold 2 records, not 3"):
         RECORD.unpack(data, 3)
+
+
+def test_defaults_and_padded_f32_uniforms():
+    params = f32_uniform("Params", ["a", "b", "c", "d", "e"])
+    assert params.names == ("a", "b", "c", "d", "e", "_pad0", "_pad1", "_pad2") and params.size == 32
+    assert np.array_equal(np.frombuffer(params.pack(dict(a=1, b=2, c=3, d=4, e=5)), np.float32),
+                          [1, 2, 3, 4, 5, 0, 0, 0])
+    assert f32_uniform("Empty", []).names == ("_unused", "_pad0", "_pad1", "_pad2")
+    assert f32_uniform("Empty", []).pack({}) == bytes(16)
+    with pytest.raises(ValueError, match="no value for field 'e'"):
+        params.pack(dict(a=1, b=2, c=3, d=4))
+    with pytest.raises(ValueError, match="not a field"):
+        Struct("S", [("a", "f32")], defaults={"b": 0})
 
 
 def test_constants():

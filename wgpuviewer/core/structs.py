@@ -110,7 +110,8 @@ def _dtype(t: FieldType) -> np.dtype:
 class Struct:
     """A WGSL struct generated from Python: ``Struct("Light", [("position", "vec3f"), ("radius", "f32")])``."""
 
-    def __init__(self, name: str, fields: Sequence[tuple[str, FieldType]], address_space: str = "uniform"):
+    def __init__(self, name: str, fields: Sequence[tuple[str, FieldType]], address_space: str = "uniform",
+                 defaults: Mapping[str, object] | None = None):
         if address_space not in ADDRESS_SPACES:
             raise ValueError(f"struct {name}: address space {address_space!r} is not one of {ADDRESS_SPACES}")
         if not fields:
@@ -118,10 +119,15 @@ class Struct:
         self.name = name
         self.fields: tuple[tuple[str, FieldType], ...] = tuple(fields)
         self.address_space = address_space
+        #: Values ``pack`` takes for fields it is given none for (e.g. padding); every other field is required.
+        self.defaults = dict(defaults or {})
         names = [n for n, _ in self.fields]
         for n in names:
             if names.count(n) > 1:
                 raise ValueError(f"struct {name}: field {n!r} appears twice")
+        for n in self.defaults:
+            if n not in names:
+                raise ValueError(f"struct {name}: a default for {n!r}, which is not a field")
         offsets: dict[str, int] = {}
         offset = 0
         for n, t in self.fields:
@@ -204,11 +210,11 @@ class Struct:
         unknown = [n for n in values if n not in self.offsets]
         if unknown:
             raise ValueError(f"struct {self.name} has no field {unknown[0]!r} (fields: {', '.join(self.names)})")
-        missing = [n for n in self.names if n not in values]
+        missing = [n for n in self.names if n not in values and n not in self.defaults]
         if missing:
             raise ValueError(f"struct {self.name}: no value for field {missing[0]!r}")
         for n, t in self.fields:
-            value = values[n]
+            value = values[n] if n in values else self.defaults[n]
             if isinstance(t, Struct):
                 t._fill(record[n], value)
             elif isinstance(t, ArrayType) and isinstance(t.element, Struct):
@@ -244,6 +250,15 @@ class Struct:
         if count > available:
             raise ValueError(f"struct {self.name}: {len(buffer)} bytes hold {available} records, not {count}")
         return np.frombuffer(buffer[: count * self.size], self.dtype).copy()
+
+
+def f32_uniform(name: str, fields: Sequence[str], pad_to: int = 16) -> Struct:
+    """A uniform of f32 ``fields`` (at least one: ``_unused``), padded with zeroed ``_padN`` fields to a multiple of
+    ``pad_to`` bytes (the technique and filter parameter records)."""
+    names = list(fields) or ["_unused"]
+    pads = [f"_pad{i}" for i in range(-len(names) % (pad_to // 4))]
+    return Struct(name, [(n, "f32") for n in names + pads], "uniform",
+                  defaults={n: 0.0 for n in pads + (["_unused"] if not fields else [])})
 
 
 def f32_literal(x: float) -> str:

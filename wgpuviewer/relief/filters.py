@@ -14,9 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.structs import Struct, f32_literal, f32_uniform, range_constants
 from wgpuviewer.core.wgsl import Generated
 
 from .techniques import Param, Parametrized, resolve_params
@@ -152,41 +151,33 @@ def resolve_filter_params(f: Filter, overrides: dict | None = None, where: str =
     return resolve_params(f, overrides, where, "filter")
 
 
-def _f32(x: float) -> str:
-    text = repr(float(x))
-    return text if "e" in text or "." in text else text + ".0"
+def filter_params(f: Filter) -> Struct:
+    """The filter's FilterParams uniform: its parameters in order, padded to 16 bytes (all f32; the filter WGSL
+    converts counts where it uses them)."""
+    return f32_uniform("FilterParams", f.uniform_fields)
 
 
 def filter_uniform_size(f: Filter) -> int:
-    n = max(len(f.uniform_fields), 1)
-    return 4 * (n + (-n % 4))
+    return filter_params(f).size
 
 
 def filter_interface(f: Filter) -> Generated:
     """The WGSL a filter's module must agree on with Python: FilterParams, parameter caps, flags, constants."""
-    fields = list(f.uniform_fields) or ["_unused"]
-    fields += [f"_pad{i}" for i in range(-len(fields) % 4)]
     lines = [f"// Generated from the registry entry of filter {f.name!r} (wgpuviewer/relief/filters.py).",
-             "struct FilterParams {", *(f"    {name}: f32," for name in fields), "}",
-             f"const VIS_TOLERANCE: f32 = {_f32(VIS_TOLERANCE)};",
-             f"const DERIVATIVE_LIMIT: f32 = {_f32(DERIVATIVE_LIMIT)};"]
+             filter_params(f).wgsl().rstrip("\n"),
+             f"const VIS_TOLERANCE: f32 = {f32_literal(VIS_TOLERANCE)};",
+             f"const DERIVATIVE_LIMIT: f32 = {f32_literal(DERIVATIVE_LIMIT)};"]
     lines += [f"const FLAG_{name.upper()}: u32 = {bit}u;" for name, bit in FLAGS.items()]
-    for p in f.params:
-        if p.kind is not bool:
-            lines += [f"const {p.name.upper()}_MIN: f32 = {_f32(p.min)};",
-                      f"const {p.name.upper()}_MAX: f32 = {_f32(p.max)};"]
+    lines += range_constants(f.params)
     lines += [f"@group({FILTER_GROUP}) @binding(0) var<uniform> filter_params: FilterParams;",
               f"@group({FILTER_GROUP}) @binding(1) var filter_sampler: sampler;"]
     return Generated(f"<generated: {f.name} filter interface>", "\n".join(lines) + "\n")
 
 
-def pack_filter_params(f: Filter, params: dict) -> np.ndarray:
-    """FilterParams uniform data (field order of ``Filter.uniform_fields``; missing values take the defaults)."""
+def pack_filter_params(f: Filter, params: dict) -> bytes:
+    """FilterParams uniform data (missing values take the defaults)."""
     values = {**f.defaults(), **params}
-    data = np.zeros(filter_uniform_size(f) // 4, np.float32)
-    for i, name in enumerate(f.uniform_fields):
-        data[i] = float(values[name])
-    return data
+    return filter_params(f).pack({name: float(values[name]) for name in f.uniform_fields})
 
 
 def sampler_descriptor(f: Filter, params: dict) -> dict:

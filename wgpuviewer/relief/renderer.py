@@ -40,7 +40,7 @@ from .filters import (
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
 from .probe import probe
 from .shaders import MAX_LIGHTS, compose_technique, pack_trace_params, trace_params_size
-from .techniques import AUTO_CANDIDATES, Technique, get_technique, resolve_params
+from .techniques import Technique, get_technique, resolve_params
 
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
 DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, depth, fetches
@@ -401,7 +401,7 @@ class Renderer:
         header = np.zeros(8, np.float32)
         header[:3] = camera.position
         counts = np.array([len(self.scene.lights), MODES[mode]], np.uint32)
-        scalars = np.array([technique.cost_scale(params), *layer_range(params), 0.0, 0.0, 0.0], np.float32)
+        scalars = np.array([technique.cost_scale(params), *technique.layer_range(params), 0.0, 0.0, 0.0], np.float32)
         data = b"".join([cam.to_wgsl(view_proj).tobytes(), header[:4].tobytes(), counts.tobytes(),
                          scalars.tobytes(), lights.tobytes()])
         self.gpu.device.queue.write_buffer(self._frame_buffer, 0, data)
@@ -500,7 +500,7 @@ class Renderer:
             color=_read_texture(device, color, 4, np.uint8),
             data=_read_texture(device, data, 4, np.uint32).view(np.float32),
             layers=_read_texture(device, layers, 1, np.uint32)[:, :, 0],
-            layer_range=layer_range(draw.values),
+            layer_range=get_technique(draw.technique).layer_range(draw.values),
             filter=_read_texture(device, stats, 4, np.uint32),
         )
 
@@ -516,16 +516,6 @@ def _reported_against_height(material, kind: str):
         if ref is None or not ref.origin:
             raise
         raise ref.error(f"its {kind} map cannot be built: {error}") from None
-
-
-def layer_range(params: dict) -> tuple[float, float]:
-    """(lo, hi) of the layers mode's grey (N - lo) / (hi - lo) (render.wgsl's layer_grey gets them in Frame).
-    auto reports its chosen candidate (1-based, cheapest first) instead of a layer count."""
-    if "max_error" in params:
-        return 1.0, float(len(AUTO_CANDIDATES))
-    if params.get("max_layers", 0) > 0:
-        return float(params.get("min_layers", 0)), float(params["max_layers"])
-    return 0.0, float(max(params.get("layers", 0), params.get("linear_steps", 0), 1))
 
 
 def _read_texture(device, texture, channels: int, dtype) -> np.ndarray:

@@ -12,8 +12,7 @@ Only the draw's filter and derivative source are compiled.
 
 from __future__ import annotations
 
-import numpy as np
-
+from wgpuviewer.core.structs import Struct, f32_uniform, range_constants
 from wgpuviewer.core.wgsl import Generated, Module, compose
 from wgpuviewer.scene import MAX_LIGHTS
 
@@ -24,22 +23,17 @@ from .techniques import MAX_LAYERS, Technique
 # MAX_LIGHTS (the scene format's limit) sizes the Frame uniform's light array (generated into render.wgsl).
 
 
-def _f32(x: float) -> str:
-    text = repr(float(x))
-    return text if "e" in text or "." in text else text + ".0"
+def trace_params(technique: Technique) -> Struct:
+    """The technique's TraceParams uniform: ``Technique.trace_fields`` in order, padded to 16 bytes. Every field
+    is f32, counts and flags too: the technique WGSL files convert them where they use them."""
+    return f32_uniform("TraceParams", technique.trace_fields)
 
 
 def interface(technique: Technique, entry: str) -> Generated:
     """The WGSL a technique's module must agree on with Python, generated from its registry entry."""
-    fields = list(technique.trace_fields)
-    fields += [f"_pad{i}" for i in range(-len(fields) % 4)]  # uniform size: a multiple of 16 bytes
     lines = [f"// Generated from the registry entry of technique {technique.name!r} (wgpuviewer/relief).",
-             "struct TraceParams {", *(f"    {name}: f32," for name in fields), "}",
-             f"const MAX_LAYERS: u32 = {MAX_LAYERS}u;"]
-    for p in technique.params:
-        if p.kind is not bool:
-            lines += [f"const {p.name.upper()}_MIN: f32 = {_f32(p.min)};",
-                      f"const {p.name.upper()}_MAX: f32 = {_f32(p.max)};"]
+             trace_params(technique).wgsl().rstrip("\n"), f"const MAX_LAYERS: u32 = {MAX_LAYERS}u;",
+             *range_constants(technique.params)]
     if entry == "render":
         lines.append(f"const MAX_LIGHTS: u32 = {MAX_LIGHTS}u;")
     lines += [f"@group(1) @binding({PARAMS_BINDING}) var<uniform> trace_params: TraceParams;",
@@ -76,19 +70,15 @@ def compose_technique(technique: Technique, entry: str, filter: str = DEFAULT_FI
 
 
 def trace_params_size(technique: Technique) -> int:
-    n = len(technique.trace_fields)
-    return 4 * (n + (-n % 4))
+    return trace_params(technique).size
 
 
 def pack_trace_params(technique: Technique, height_scale: float, depth_shape: tuple, params: dict,
-                      depth_range: tuple[float, float] = (0.0, 1.0)) -> np.ndarray:
-    """TraceParams uniform data for ``technique`` (field order of ``Technique.trace_fields``; booleans as 0/1).
+                      depth_range: tuple[float, float] = (0.0, 1.0)) -> bytes:
+    """TraceParams uniform data for ``technique`` (booleans as 0/1).
     ``params`` holds the parameter values (missing ones take the registry defaults); ``depth_range`` is the depth
     map's (maps.depth_range; the default claims nothing about the map)."""
     values = {**technique.defaults(), **params, **dict(technique.fixed),
               "height_scale": height_scale, "depth_width": depth_shape[1], "depth_height": depth_shape[0],
               "depth_min": depth_range[0], "depth_max": depth_range[1]}
-    data = np.zeros(trace_params_size(technique) // 4, np.float32)
-    for i, name in enumerate(technique.trace_fields):
-        data[i] = float(values[name])
-    return data
+    return trace_params(technique).pack({name: float(values[name]) for name in technique.trace_fields})
