@@ -14,6 +14,7 @@ import numpy as np
 from wgpuviewer.core.compute import compute_for
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import get_gpu
+from wgpuviewer.core.structs import Struct
 from wgpuviewer.core.wgsl import Module, compose
 
 from . import cpu
@@ -23,9 +24,47 @@ FIX = "use --backend cpu"
 _WG = (8, 8, 1)  # @workgroup_size of every kernel
 
 
+#: Each kernel's uniform P (``common/map_buffers.wgsl``), generated into its module.
+PARAMS = {
+    "normal.wgsl": Struct("Params", [
+        ("width", "u32"), ("height", "u32"), ("border", "u32"),  # border: the Sobel border (common/border.wgsl)
+        ("strength", "f32"), ("ysign", "f32")]),  # ysign: +1 OpenGL (y towards row 0), -1 DirectX
+    "complexity.wgsl": Struct("Params", [
+        ("width", "u32"), ("height", "u32"), ("border", "u32"), ("ksize", "u32"),  # ksize: 3 or 5
+        ("radius", "u32"),  # dilation radius = (kernel // 2) * iterations
+        ("wrap_dilate", "u32"),  # 1: dilation wraps (repeat); 0: window clamped to the image (OpenCV's default)
+        ("levels", "u32"), ("gamma", "f32"),
+        ("step", "f32")]),  # f32(1 / (levels - 1)), as numpy computes it
+    "maxmip.wgsl": Struct("Params", [("src_size", "vec2u"), ("dst_size", "vec2u")]),  # (w, h) of child, parent
+    "distance.wgsl": Struct("Params", [
+        ("width", "u32"), ("height", "u32"), ("slices", "u32"), ("subcells", "u32"),  # subcells: K
+        ("sw", "f32"),  # S * W: metric length of the whole depth range t in [0, 1]
+        ("sy", "f32"),  # W / H: metric height of one texel row
+        ("dz", "f32"),  # metric thickness of one slice
+        ("grow", "f32"),  # every voxel box is grown by this on each side (maptools.distance.BOX_GROW)
+        ("margin", "f32")]),  # subtracted from every stored distance
+    "distance_refined.wgsl": Struct("Params", [
+        ("width", "u32"), ("height", "u32"), ("slices", "u32"), ("subcells", "u32"),
+        ("count", "u32"),  # columns in the list
+        ("levels", "u32"),  # window levels (window_tops)
+        ("bands", "u32"),  # polar bands written (1 to 4), one per vec4 lane of:
+        ("tan_lo", "vec4f"),  # tan of the band's least polar angle
+        ("cot_hi", "vec4f"),  # cot of its largest polar angle
+        ("inv_sin_hi", "vec4f"),  # 1 / sin of its largest polar angle
+        ("cap", "vec4f"),  # reach / sin of its largest polar angle
+        ("dz", "f32"), ("grow", "f32"), ("margin", "f32"), ("sw", "f32")]),  # as distance.wgsl's
+    "cone.wgsl": Struct("Params", [
+        ("width", "u32"), ("height", "u32"), ("rings", "u32"), ("sy", "f32"), ("max_ratio", "f32"),
+        ("keep", "f32"),  # 1 - store margin
+        ("dmin", "f32"),  # global min depth
+        ("band", "f32")]),  # relative "may exit" band
+}
+
+
 def kernel_source(file: str) -> Module:
-    """The composed module of kernel ``file`` (in ``wgsl/maps/``): what the GPU runs and the cache key hashes."""
-    return compose(f"maps/{file}")
+    """The composed module of kernel ``file`` (in ``wgsl/maps/``, with its generated Params): what the GPU runs
+    and the cache key hashes."""
+    return compose(PARAMS[file].generated(), f"maps/{file}")
 
 
 class MapGpu:
@@ -47,12 +86,9 @@ class MapGpu:
     def storage(self, data_or_size, label: str):
         return self.compute.storage(data_or_size, label, FIX)
 
-    def uniform(self, words: list, label: str):
-        """Uniform buffer from a list of ints (u32) and floats (f32), padded to 16-byte multiples."""
-        arr = np.zeros(((len(words) + 3) // 4) * 4, np.uint32)
-        for i, v in enumerate(words):
-            arr[i] = np.float32(v).view(np.uint32) if isinstance(v, float) else np.uint32(v)
-        return self.compute.uniform(arr, label)
+    def uniform(self, file: str, values: dict):
+        """The Params uniform of kernel ``file`` holding ``values`` (every field, by name)."""
+        return self.compute.uniform(PARAMS[file].pack(values), f"maptools {file} params")
 
     def dispatch(self, encoder, file: str, entry: str, bindings: dict, w: int, h: int, d: int = 1) -> None:
         """One compute pass: ``entry`` of ``file`` over w x h (x d, one workgroup layer per slice) invocations."""
@@ -97,8 +133,8 @@ def normal(g: MapGpu, height: np.ndarray, *, strength: float = 1.0, y: str = "op
     g.check_size(h, w, 3)
     src = g.storage(height, "maptools normal src")
     dst = g.storage(h * w * 12, "maptools normal dst")
-    params = g.uniform([w, h, cpu.BORDER_CODE[border], 0, float(strength), 1.0 if y == "opengl" else -1.0],
-                       "maptools normal params")
+    params = g.uniform("normal.wgsl", {"width": w, "height": h, "border": cpu.BORDER_CODE[border],
+                                       "strength": strength, "ysign": 1.0 if y == "opengl" else -1.0})
     enc = g.encoder("maptools normal")
     g.dispatch(enc, "normal.wgsl", "main", {0: params, 1: src, 2: dst}, w, h)
     g.submit(enc)
@@ -117,9 +153,10 @@ def complexity(g: MapGpu, height: np.ndarray, *, ksize: int = 3, dilate_kernel: 
     out = g.storage(h * w * 4, "maptools complexity out")
     maxbits = g.storage(np.zeros(4, np.uint32), "maptools complexity max")
     step = float(np.float32(1.0 / (levels - 1)))
-    params = g.uniform([w, h, cpu.BORDER_CODE[border], ksize, cpu.dilation_radius(dilate_kernel, iterations),
-                        1 if border == "repeat" else 0, levels, 0, float(gamma), step],
-                       "maptools complexity params")
+    params = g.uniform("complexity.wgsl", {
+        "width": w, "height": h, "border": cpu.BORDER_CODE[border], "ksize": ksize,
+        "radius": cpu.dilation_radius(dilate_kernel, iterations), "wrap_dilate": 1 if border == "repeat" else 0,
+        "levels": levels, "gamma": gamma, "step": step})
     enc = g.encoder("maptools complexity")
     g.dispatch(enc, "complexity.wgsl", "sobel_mag", {0: params, 1: src, 2: mag, 3: maxbits}, w, h)
     g.dispatch(enc, "complexity.wgsl", "dilate_h", {0: params, 1: mag, 2: tmp}, w, h)
@@ -138,7 +175,7 @@ def maxmip(g: MapGpu, height: np.ndarray):
     for k, (ph, pw) in enumerate(sizes[1:], start=1):
         sh, sw = sizes[k - 1]
         bufs.append(g.storage(ph * pw * 4, f"maptools maxmip level {k}"))
-        params = g.uniform([sw, sh, pw, ph], f"maptools maxmip params {k}")
+        params = g.uniform("maxmip.wgsl", {"src_size": (sw, sh), "dst_size": (pw, ph)})
         g.dispatch(enc, "maxmip.wgsl", "reduce", {0: params, 1: bufs[k - 1], 2: bufs[k]}, pw, ph)
     g.submit(enc)
     out = [height.copy()]
@@ -162,8 +199,9 @@ def _plain_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale
     from . import distance as dist
 
     k = subcells
-    params = g.uniform([w, h, slices, k, float(height_scale * w), float(w / h), float(height_scale * w / slices),
-                        float(dist.BOX_GROW), float(dist.STORE_MARGIN)], f"maptools {label} params")
+    params = g.uniform("distance.wgsl", {
+        "width": w, "height": h, "slices": slices, "subcells": k, "sw": height_scale * w, "sy": w / h,
+        "dz": height_scale * w / slices, "grow": dist.BOX_GROW, "margin": dist.STORE_MARGIN})
     tops = g.storage(w * h * k * k * 4, f"maptools {label} sub-cell tops")
     rows = g.storage(w * h * k * slices * 4, f"maptools {label} row pass")
     out = g.storage(w * h * slices * 4, f"maptools {label} volume")
@@ -220,12 +258,13 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
     for number, (sector, b0) in enumerate(tqdm(passes, desc="distance_refined (gpu)", unit="pass",
                                                disable=None if progress else True, leave=False)):
         group = [directions[b * sectors + sector] for b in range(b0, min(b0 + rf.BANDS_PER_PASS, bands))]
-        lane = [0.0] * (4 - len(group))
-        p = g.uniform([w, h, slices, subcells, len(lists[sector].rho), levels, len(group), 0,
-                       *[float(d.tan_lo) for d in group], *lane, *[float(d.cot_hi) for d in group], *lane,
-                       *[float(1.0 / d.sin_hi) for d in group], *lane, *[float(reach / d.sin_hi) for d in group],
-                       *lane, float(height_scale * w / slices), float(dist.BOX_GROW), float(dist.STORE_MARGIN),
-                       float(height_scale * w)], "maptools distance_refined pass params")
+        lane = [0.0] * (4 - len(group))  # bands of the group, one per vec4 lane; unused lanes 0
+        p = g.uniform("distance_refined.wgsl", {
+            "width": w, "height": h, "slices": slices, "subcells": subcells, "count": len(lists[sector].rho),
+            "levels": levels, "bands": len(group), "tan_lo": [d.tan_lo for d in group] + lane,
+            "cot_hi": [d.cot_hi for d in group] + lane, "inv_sin_hi": [1.0 / d.sin_hi for d in group] + lane,
+            "cap": [reach / d.sin_hi for d in group] + lane, "dz": height_scale * w / slices,
+            "grow": dist.BOX_GROW, "margin": dist.STORE_MARGIN, "sw": height_scale * w})
         cbuf = g.storage(lists[sector].packed(w, h, subcells), "maptools distance_refined columns")
         enc = g.encoder("maptools distance_refined pass")
         if number == 0:
@@ -252,9 +291,9 @@ def cone(g: MapGpu, height: np.ndarray, *, max_ratio: float = 16.0, filter: str 
     src = g.storage(height, "maptools cone src")
     raw = g.storage(h * w * 4, "maptools cone raw")
     out = g.storage(h * w * 4, "maptools cone out")
-    params = g.uniform([w, h, cn.ring_count(max_ratio, w, h), 0, float(w / h), float(max_ratio),
-                        float(1.0 - cn.STORE_MARGIN), dmin, float(cn.EXIT_BAND), 0.0, 0.0, 0.0],
-                       "maptools cone params")
+    params = g.uniform("cone.wgsl", {"width": w, "height": h, "rings": cn.ring_count(max_ratio, w, h), "sy": w / h,
+                                     "max_ratio": max_ratio, "keep": 1.0 - cn.STORE_MARGIN, "dmin": dmin,
+                                     "band": cn.EXIT_BAND})
     enc = g.encoder("maptools cone")
     g.dispatch(enc, "cone.wgsl", "ratio", {0: params, 1: src, 2: raw}, w, h)
     if filter == "bilinear":

@@ -1,5 +1,5 @@
 // Map kernels (maptools): row-major f32 buffers, index = row * width + col; col = u (x), row = v (y).
-// The kernel's own `struct Params` is its uniform P; it reads src and writes dst.
+// The kernel's Params struct (generated: maptools.gpu.PARAMS) is its uniform P; it reads src and writes dst.
 // #include "common/border.wgsl"
 
 @group(0) @binding(0) var<uniform> P: Params;

@@ -1,23 +1,9 @@
-// Complexity map (thesis 002, complexity_calculator.py) in three passes:
+// Complexity map (the adaptive-POM thesis, complexity_calculator.py) in three passes:
 //   sobel_mag:       Sobel (ksize 3 or 5) -> magnitude; global max via atomicMax on the f32 bits (mag >= 0)
 //   dilate_h:        horizontal max over +-radius (the repeated 3x3 dilation is a (2r+1)^2 box max)
 //   dilate_v_finish: vertical max, / max, gamma, quantise to `levels`, 8-bit by truncation (stored as f32)
 // Dividing after the max equals the listing's divide-then-dilate: rounded division is monotonic.
 // #include "common/sobel.wgsl"
-
-struct Params {
-    width: u32,
-    height: u32,
-    border: u32,       // Sobel border (common/border.wgsl)
-    ksize: u32,        // 3 or 5
-    radius: u32,       // dilation radius = (kernel // 2) * iterations
-    wrap_dilate: u32,  // 1: dilation wraps (repeat); 0: window clamped to the image (OpenCV default)
-    levels: u32,
-    _pad: u32,
-    gamma: f32,
-    step: f32,         // f32(1 / (levels - 1)), as numpy computes it
-    _pad2: vec2f,
-};
 
 @group(0) @binding(3) var<storage, read_write> maxbits: atomic<u32>;
 

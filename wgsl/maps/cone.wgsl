@@ -7,21 +7,6 @@
 //   clamped to max_ratio and multiplied by (1 - margin).  min3x3: optional 3x3 min (filter = bilinear).
 // #include "common/map_buffers.wgsl"
 
-struct Params {
-    width: u32,
-    height: u32,
-    rings: u32,
-    _pad0: u32,
-    sy: f32,
-    max_ratio: f32,
-    keep: f32,        // 1 - store margin
-    dmin: f32,        // global min depth
-    band: f32,        // relative "may exit" band
-    _pad1: f32,
-    _pad2: f32,
-    _pad3: f32,
-};
-
 fn depth(i: i32, j: i32) -> f32 {
     let w = i32(P.width);
     let h = i32(P.height);

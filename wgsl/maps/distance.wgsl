@@ -7,21 +7,6 @@
 // bounded by half a period. Volumes are f32 buffers indexed (k * rows + row) * W + i.
 // #include "common/map_buffers.wgsl"
 
-struct Params {
-    width: u32,
-    height: u32,
-    slices: u32,
-    subcells: u32,   // K
-    sw: f32,         // S * W: metric length of the whole depth range t in [0, 1]
-    sy: f32,         // W / H: metric height of one texel row
-    dz: f32,         // metric thickness of one slice
-    grow: f32,       // every voxel box is grown by this on each side (maptools.distance.BOX_GROW)
-    margin: f32,     // subtracted from every stored distance
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
-};
-
 // Bilinear depth (repeat) at the sub-cell vertex (a, b): X = 0.5 + a / K, Y = (0.5 + b / K) * sy.
 fn vertex_depth(a: u32, b: u32) -> f32 {
     let k = P.subcells;

@@ -14,25 +14,6 @@
 //   main:        src = the stored plain volume, dst = the bands' volumes (band, slice, row, column)
 // #include "common/map_buffers.wgsl"
 
-struct Params {
-    width: u32,
-    height: u32,
-    slices: u32,
-    subcells: u32,      // K
-    count: u32,         // columns in the list
-    levels: u32,        // window levels (window_tops)
-    bands: u32,         // polar bands written (1 to 4)
-    _pad: u32,
-    tan_lo: vec4f,      // per band: tan of its least polar angle
-    cot_hi: vec4f,      // cot of its largest polar angle
-    inv_sin_hi: vec4f,  // 1 / sin of its largest polar angle
-    cap: vec4f,         // reach / sin of its largest polar angle
-    dz: f32,            // metric thickness of one slice
-    grow: f32,          // voxel boxes are grown by this on each side
-    margin: f32,
-    sw: f32,            // S * W (window_tops)
-};
-
 struct Column {
     ox: u32,      // offset from the voxel's own sub-cell (level 0) or cell (level >= 1), modulo the period
     oy: u32,

@@ -4,11 +4,6 @@
 // odd and non-square sizes.
 // #include "common/map_buffers.wgsl"
 
-struct Params {
-    src_size: vec2u,  // (w, h) of the child level
-    dst_size: vec2u,  // (ceil(w/2), ceil(h/2))
-};
-
 @compute @workgroup_size(8, 8)
 fn reduce(@builtin(global_invocation_id) gid: vec3u) {
     let parent = gid.xy;

@@ -3,16 +3,6 @@
 // ysign = +1 for the OpenGL convention (y towards row 0, "green up"), -1 for DirectX (y towards +row).
 // #include "common/sobel.wgsl"
 
-struct Params {
-    width: u32,
-    height: u32,
-    border: u32,
-    _pad: u32,
-    strength: f32,
-    ysign: f32,
-    _pad2: vec2f,
-};
-
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     if (gid.x >= P.width || gid.y >= P.height) { return; }
