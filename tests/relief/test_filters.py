@@ -19,14 +19,33 @@ from wgpuviewer.studies.filtering import cpu
 from wgpuviewer.textures import builtin_albedo, builtin_height
 
 CONTRACT = ("nearest", "bilinear", "trilinear", "aniso", "ewa", "ewa_approx", "ewa_vis", "ewa_vis_rows")
-#: Filters with a float64 twin (aniso's probes are the driver's), and how close the GPU must come: EWA reads
-#: texels with textureLoad (float32 arithmetic only); the hardware ones blend with the sampler's weights and
-#: pick their own level (trilinear's level formula is approximated by GPUs).
-TOLERANCE = {"nearest": 0.0, "bilinear": 5e-3, "trilinear": 0.03, "ewa": 1e-4, "ewa_approx": 5e-3,
-             "ewa_vis": 1e-4, "ewa_vis_rows": 1e-4}
+#: Every filter with a float64 twin, by the tolerance its registry entry declares.
+TOLERANCE = {f.name: f.twin_tolerance for f in FILTERS.values() if f.twin_tolerance is not None}
 
 
 # --- the registry -------------------------------------------------------------------------------------------
+
+
+def test_every_filter_declares_its_twin_or_why_not():
+    """A filter has a tolerance against its float64 twin (cpu_filter returns a value for it, and the GPU twin tests
+    below run it) or a stated reason it has none (and cpu_filter has no twin for it): never neither, never both."""
+    levels = texture_levels(textures()["noise 64x48"])
+    for f in FILTERS.values():
+        assert (f.twin_tolerance is None) == bool(f.no_twin), f.name
+        twin = cpu.cpu_filter(f.name, levels, np.array([0.3, 0.6]), np.array([0.01, 0.0]), np.array([0.0, 0.02]),
+                              hidden=cpu.hidden_test(np.zeros((4, 4), np.float32), (0.0, 0.0, 1.0), 0.05))
+        assert (twin is not None) == (f.twin_tolerance is not None), f.name
+        assert f.twin_tolerance is None or f.twin_tolerance >= 0.0
+    twin_tests = set(GPU_TWIN_FILTERS) | set(VISIBILITY_TWIN_FILTERS)
+    assert twin_tests == set(TOLERANCE), "every filter with a twin is run against it on the GPU"
+
+
+def test_markdown_table_lists_every_filter():
+    table = filters.markdown_table().splitlines()
+    assert table[0] == "| filter | what | reads per lookup |" and len(table) == 2 + len(FILTERS)
+    for f, row in zip(FILTERS.values(), table[2:]):
+        assert row.startswith(f"| `{f.name}`") and f.cost in row and f.description in row
+    assert "`trilinear` (default)" in filters.markdown_table()
 
 
 def test_the_contract_filters_are_registered():
@@ -155,7 +174,11 @@ def gpu_and_cpu(name, texture, uv, dx, dy, view=(0.0, 0.0, 1.0), height=None, pa
     return got, want
 
 
-@pytest.mark.parametrize("name", [n for n in TOLERANCE if not FILTERS[n].visibility])
+GPU_TWIN_FILTERS = [n for n in TOLERANCE if not FILTERS[n].visibility]
+VISIBILITY_TWIN_FILTERS = [n for n in TOLERANCE if FILTERS[n].visibility]
+
+
+@pytest.mark.parametrize("name", GPU_TWIN_FILTERS)
 def test_gpu_filter_equals_its_float64_twin(gpu, name):
     for label, texture in textures().items():
         uv, dx, dy = footprints(200, texture.shape[1::-1], seed=len(label))
@@ -167,7 +190,7 @@ def test_gpu_filter_equals_its_float64_twin(gpu, name):
             assert (got.flags == [w.flags for w in want]).all(), label
 
 
-@pytest.mark.parametrize("name", ["ewa_vis", "ewa_vis_rows"])
+@pytest.mark.parametrize("name", VISIBILITY_TWIN_FILTERS)
 @pytest.mark.parametrize("relief", ["bricks", "step"])
 def test_visibility_filters_equal_their_float64_twins(gpu, name, relief):
     """The GPU traces with maxmip (exact to float32); the twin with the float64 exact hit. Both drop the same

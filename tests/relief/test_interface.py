@@ -1,6 +1,7 @@
-"""One source of truth for the GPU interface: the registry generates what WGSL must agree on (TraceParams, the
-parameter constants, the binding lines of a technique's texture slots); what stays hand-written in WGSL (Frame,
-ProbeRay, ProbeHit, DataOut) is checked here against the Python side. And a throw-away technique with a new
+"""One source of truth for the GPU interface: the registry and core.structs generate what WGSL must agree on
+(TraceParams, the render entry's Frame and Object, the parameter constants, the binding lines of a technique's
+texture slots); what stays hand-written in WGSL (ProbeRay, ProbeHit, DataOut) is checked here against the Python
+side. And a throw-away technique with a new
 parameter and a new map slot renders and probes without touching any other file."""
 
 from __future__ import annotations
@@ -61,9 +62,16 @@ def layout(source: str, wgsl_type: str, constants: dict) -> tuple[int, int]:
     return _round_up(offset, align), align
 
 
-def test_frame_matches_the_renderer():
-    source = read_wgsl("entry/render.wgsl")
-    assert layout(source, "Frame", {"MAX_LIGHTS": shaders.MAX_LIGHTS})[0] == renderer.FRAME_SIZE
+def test_render_uniforms_are_generated():
+    """Frame's layout (camera 64 bytes after the matrix, the counts and scales packed after it, the lights at the
+    next 16 bytes) and the render interface declaring Frame, Light and Object, which render.wgsl does not."""
+    assert shaders.FRAME.offsets == {"view_proj": 0, "camera_pos": 64, "light_count": 80, "mode": 84,
+                                     "cost_scale": 88, "layer_lo": 92, "layer_hi": 96, "lights": 112}
+    assert shaders.FRAME.size == 112 + 32 * shaders.MAX_LIGHTS and shaders.OBJECT.size == 144
+    text = shaders.interface(TECHNIQUES["pom"], "render").text
+    assert shaders.FRAME.wgsl_all() in text and shaders.OBJECT.wgsl() in text
+    assert "struct " not in shaders.interface(TECHNIQUES["pom"], "probe").text.replace("struct TraceParams", "")
+    assert not re.search(r"struct (Frame|Light|Object) ", read_wgsl("entry/render.wgsl"))
 
 
 def test_probe_structs_match_the_probe():
@@ -84,9 +92,10 @@ def test_data_out_matches_the_offscreen_targets():
 def test_generated_interface_follows_the_registry():
     for t in TECHNIQUES.values():
         text = shaders.interface(t, "render").text
-        fields = re.findall(r"^    (\w+): f32,$", text, re.M)
-        assert fields[: len(t.trace_fields)] == list(t.trace_fields)
-        assert len(fields) * 4 == shaders.trace_params_size(t) and shaders.trace_params_size(t) % 16 == 0
+        params = shaders.trace_params(t)
+        assert params.wgsl() in text and params.names[: len(t.trace_fields)] == t.trace_fields
+        assert params.size == shaders.trace_params_size(t) and params.size % 16 == 0
+        assert len(shaders.pack_trace_params(t, 1.0, (4, 4), {})) == params.size
         for p in t.params:
             if p.kind is not bool:
                 assert f"const {p.name.upper()}_MAX: f32 = " in text

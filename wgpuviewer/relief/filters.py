@@ -2,12 +2,13 @@
 
 A filter decides how the albedo and the normal map are read at the traced hit (``entry/render.wgsl`` calls its
 ``filter_texture`` for both): from one texel (``nearest``) to an elliptical weighted average over the pixel's
-footprint that drops the texels the relief hides (``ewa_vis``, seed 003). A derivative source decides which
-footprint the filter is given: the derivatives of the unperturbed surface uv (today's), of the traced hit uv, or
-the hit's local Jacobian. Everything WGSL must agree on is generated from these entries (``filter_interface``):
-the ``FilterParams`` uniform (the filter's parameters, padded), ``NAME_MIN`` / ``NAME_MAX`` constants for them, the
-stat flags, the visibility tolerance and the derivative bound. The renderer makes the filter's sampler from
-``Filter.sampler`` (WebGPU allows anisotropy only with linear min, mag and mipmap filters).
+footprint that drops the texels the relief hides (``ewa_vis``, after Romanyuk & Dudnyk 2017, filtering with parallax
+mapping). A derivative source decides which footprint the filter is given: the derivatives of the unperturbed
+surface uv (the default), of the traced hit uv, or the hit's local Jacobian. Everything WGSL must agree on is
+generated from these entries (``filter_interface``): the ``FilterParams`` uniform (the filter's parameters, padded),
+``NAME_MIN`` / ``NAME_MAX`` constants for them, the stat flags, the visibility tolerance and the derivative bound.
+The renderer makes the filter's sampler from ``Filter.sampler`` (WebGPU allows anisotropy only with linear min, mag
+and mipmap filters).
 """
 
 from __future__ import annotations
@@ -56,6 +57,11 @@ class Filter(Parametrized):
     visibility: bool = False
     #: Takes derivatives: nearest and bilinear read level 0 and ignore them.
     uses_derivatives: bool = True
+    #: Largest |GPU - float64 twin| of a filtered value on the same footprints (the twin:
+    #: ``wgpuviewer.studies.filtering.cpu.cpu_filter``; tests/relief/test_filters.py holds every filter to it).
+    twin_tolerance: float | None = None
+    #: Why the filter has no twin (then ``twin_tolerance`` is None): every filter has one or the other.
+    no_twin: str = ""
 
     @property
     def wgsl_file(self) -> str:
@@ -90,31 +96,37 @@ FILTERS: dict[str, Filter] = {
     f.name: f
     for f in (
         Filter("nearest", "The texel the hit falls in, level 0: no filtering at all.", "1 texel",
-               ("nearest", "nearest", "nearest"), uses_derivatives=False),
+               ("nearest", "nearest", "nearest"), uses_derivatives=False, twin_tolerance=0.0),
         Filter("bilinear", "Hardware bilinear at level 0: no mip mapping, aliases under minification.", "4 texels",
-               ("linear", "linear", "nearest"), uses_derivatives=False),
+               ("linear", "linear", "nearest"), uses_derivatives=False,
+               twin_tolerance=5e-3),  # the sampler's fixed-point bilinear weights
         Filter("trilinear", "Hardware trilinear: mip level from the larger derivative, blended between two levels "
-               "(the renderer's behaviour before filters existed; the default).", "8 texels", _LINEAR),
+               "(the renderer's default).", "8 texels", _LINEAR,
+               twin_tolerance=0.03),  # GPUs approximate the level formula
         Filter("aniso", "Hardware anisotropic filtering (textureSampleGrad on a sampler with max_anisotropy; "
                "the probe pattern is the driver's).", "up to 8 x max_anisotropy texels (driver-defined)", _LINEAR,
-               (Param("max_anisotropy", 16, 2, 16, int, "the sampler's max_anisotropy (WebGPU: 1 to 16)"),)),
+               (Param("max_anisotropy", 16, 2, 16, int, "the sampler's max_anisotropy (WebGPU: 1 to 16)"),),
+               no_twin="the driver picks the anisotropic probes and their weights; no float64 model predicts them"),
         Filter("ewa", "Elliptical weighted average (Heckbert): Gaussian weights over the footprint ellipse from the "
                "derivatives (plus the bilinear tent's variance as prefilter), read where the minor axis spans 2-4 "
                "texels, two levels blended; a texel cap.", "pi * major * minor / 4^level texels, at most max_texels",
                _LINEAR,
-               (_MAX_TEXELS, _ALPHA), texel_loop=True),
+               (_MAX_TEXELS, _ALPHA), texel_loop=True,
+               twin_tolerance=1e-4),  # textureLoad texels: float32 arithmetic only
         Filter("ewa_approx", "EWA approximated by hardware trilinear probes along the major axis, Gaussian-weighted, "
                "at the minor axis' level (in the spirit of Mavridis & Papaioannou 2011).",
                "8 texels per probe, probes = ceil(major / minor) <= max_probes", _LINEAR,
-               (Param("max_probes", 8, 1, 32, int, "most probes along the major axis"), _ALPHA)),
-        Filter("ewa_vis", "EWA that drops the footprint texels the relief hides (seed 003's full method): the view "
-               "ray towards each texel's surface point is traced with the technique's own search; a texel whose ray "
-               "meets the relief first gets no weight.", "EWA texels + one trace per texel", _LINEAR,
-               (_MAX_TEXELS, _ALPHA), texel_loop=True, visibility=True),
-        Filter("ewa_vis_rows", "EWA with seed 003's cheap visibility: each row of the ellipse is walked from one end "
+               (Param("max_probes", 8, 1, 32, int, "most probes along the major axis"), _ALPHA),
+               twin_tolerance=5e-3),  # hardware trilinear probes
+        Filter("ewa_vis", "EWA that drops the footprint texels the relief hides (the full method of Romanyuk & "
+               "Dudnyk 2017, filtering with parallax mapping): the view ray towards each texel's surface point is "
+               "traced with the technique's own search; a texel whose ray meets the relief first gets no weight.",
+               "EWA texels + one trace per texel", _LINEAR,
+               (_MAX_TEXELS, _ALPHA), texel_loop=True, visibility=True, twin_tolerance=1e-4),
+        Filter("ewa_vis_rows", "EWA with that paper's cheap visibility: each row of the ellipse is walked from one end "
                "until a hidden texel, then from the other end back until a hidden texel; the texels between are "
                "dropped without being traced.", "EWA texels + one trace per texel walked", _LINEAR,
-               (_MAX_TEXELS, _ALPHA), texel_loop=True, visibility=True),
+               (_MAX_TEXELS, _ALPHA), texel_loop=True, visibility=True, twin_tolerance=1e-4),
     )
 }
 
@@ -123,7 +135,7 @@ DERIVATIVE_SOURCES: dict[str, DerivativeSource] = {
     for d in (
         DerivativeSource("uv", "screen-space derivatives of the unperturbed surface uv (before the ray search)",
                          traced=False),
-        DerivativeSource("displaced", "screen-space differences of the traced hit uv (seed 003, formula 3), "
+        DerivativeSource("displaced", "screen-space differences of the traced hit uv (Romanyuk & Dudnyk 2017, formula 3), "
                          f"bounded to {DERIVATIVE_LIMIT:g}x the unperturbed length"),
         DerivativeSource("analytic", "the hit's local Jacobian from the relief slope g there: "
                          "(I - P g^T / (1 + g.P)) (duv - t dP), bounded the same way"),
@@ -186,3 +198,12 @@ def sampler_descriptor(f: Filter, params: dict) -> dict:
     anisotropy = int(params.get("max_anisotropy", 1))
     return {"address_mode_u": "repeat", "address_mode_v": "repeat", "mag_filter": mag, "min_filter": minf,
             "mipmap_filter": mip, "max_anisotropy": anisotropy}
+
+
+def markdown_table() -> str:
+    """The README's filter table: name (the default marked), what it does, what it reads per lookup."""
+    rows = ["| filter | what | reads per lookup |", "|---|---|---|"]
+    for f in FILTERS.values():
+        name = f"`{f.name}`" + (" (default)" if f.name == DEFAULT_FILTER else "")
+        rows.append(f"| {name} | {f.description} | {f.cost} |")
+    return "\n".join(rows)

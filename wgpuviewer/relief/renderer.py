@@ -39,7 +39,7 @@ from .filters import (
 )
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
 from .probe import probe
-from .shaders import MAX_LIGHTS, compose_technique, pack_trace_params, trace_params_size
+from .shaders import FRAME, MAX_LIGHTS, OBJECT, compose_technique, pack_trace_params, trace_params_size
 from .techniques import Technique, get_technique, resolve_params
 
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
@@ -49,8 +49,6 @@ FILTER_FORMAT = "rgba32uint"  # offscreen: the filter's texels, depth fetches, h
 DEPTH_FORMAT = "depth32float"
 #: The targets of an offscreen render (fs_data), in order.
 OFFSCREEN_FORMATS = (COLOR_FORMAT, DATA_FORMAT, LAYERS_FORMAT, FILTER_FORMAT)
-#: Byte size of entry/render.wgsl's Frame: view_proj, camera_pos, 8 scalars, lights (a test parses the WGSL).
-FRAME_SIZE = 64 + 16 + 32 + MAX_LIGHTS * 32
 
 #: Frame.mode values (render.wgsl).
 MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4, "albedo": 5}
@@ -154,7 +152,7 @@ class Renderer:
                                          {"binding": 1, "visibility": F, "sampler": {"type": "filtering"}}]
             )
             self._samplers: dict[tuple, wgpu.GPUSampler] = {}
-        self._frame_buffer = device.create_buffer(label="frame", size=FRAME_SIZE, usage=U.UNIFORM | U.COPY_DST)
+        self._frame_buffer = device.create_buffer(label="frame", size=FRAME.size, usage=U.UNIFORM | U.COPY_DST)
         self._frame_group = device.create_bind_group(
             layout=self._frame_layout, entries=[{"binding": 0, "resource": {"buffer": self._frame_buffer}}]
         )
@@ -170,10 +168,9 @@ class Renderer:
         normal_matrix = np.eye(4)
         normal_matrix[:3, :3] = np.linalg.inv(model[:3, :3]).T
         uv_scale = self.scene.materials[obj.material].uv_scale
-        data = np.concatenate([cam.to_wgsl(model).ravel(), cam.to_wgsl(normal_matrix).ravel(), [*uv_scale, 0, 0]])
-        ubuf = device.create_buffer_with_data(
-            label=f"object:{index}", data=data.astype(np.float32), usage=wgpu.BufferUsage.UNIFORM
-        )
+        data = OBJECT.pack({"model": cam.to_wgsl(model), "normal_matrix": cam.to_wgsl(normal_matrix),
+                            "uv_scale": [*uv_scale, 0, 0]})
+        ubuf = device.create_buffer_with_data(label=f"object:{index}", data=data, usage=wgpu.BufferUsage.UNIFORM)
         group = device.create_bind_group(layout=self._object_layout, entries=[{"binding": 0, "resource": {"buffer": ubuf}}])
         return obj.material, vbuf, len(vertices), group
 
@@ -391,19 +388,18 @@ class Renderer:
         view_proj = cam.perspective(camera.fov, w / h, camera.near, camera.far) @ cam.look_at(
             camera.position, camera.target, camera.up
         )
-        lights = np.zeros((len(self.scene.lights), 8), np.float32)  # the scene checked the count (MAX_LIGHTS)
-        for i, light in enumerate(self.scene.lights):
+        lights = [{"vector": np.zeros(4), "color": np.zeros(4)} for _ in range(MAX_LIGHTS)]
+        for slot, light in zip(lights, self.scene.lights):  # the scene checked the count (MAX_LIGHTS)
             if light.kind == "directional":
-                lights[i, :4] = [*(-np.asarray(light.direction)), 0.0]  # towards the light
+                slot["vector"] = [*(-np.asarray(light.direction)), 0.0]  # towards the light
             else:
-                lights[i, :4] = [*light.position, 1.0]
-            lights[i, 4:7] = np.asarray(light.color) * light.intensity
-        header = np.zeros(8, np.float32)
-        header[:3] = camera.position
-        counts = np.array([len(self.scene.lights), MODES[mode]], np.uint32)
-        scalars = np.array([technique.cost_scale(params), *technique.layer_range(params), 0.0, 0.0, 0.0], np.float32)
-        data = b"".join([cam.to_wgsl(view_proj).tobytes(), header[:4].tobytes(), counts.tobytes(),
-                         scalars.tobytes(), lights.tobytes()])
+                slot["vector"] = [*light.position, 1.0]
+            slot["color"] = [*(np.asarray(light.color) * light.intensity), 0.0]
+        lo, hi = technique.layer_range(params)
+        data = FRAME.pack({"view_proj": cam.to_wgsl(view_proj), "camera_pos": [*camera.position, 0.0],
+                           "light_count": len(self.scene.lights), "mode": MODES[mode],
+                           "cost_scale": technique.cost_scale(params), "layer_lo": lo, "layer_hi": hi,
+                           "lights": lights})
         self.gpu.device.queue.write_buffer(self._frame_buffer, 0, data)
 
     def encode(

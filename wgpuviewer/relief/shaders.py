@@ -12,7 +12,7 @@ Only the draw's filter and derivative source are compiled.
 
 from __future__ import annotations
 
-from wgpuviewer.core.structs import Struct, f32_uniform, range_constants
+from wgpuviewer.core.structs import Struct, array, f32_uniform, range_constants
 from wgpuviewer.core.wgsl import Generated, Module, compose
 from wgpuviewer.scene import MAX_LIGHTS
 
@@ -20,7 +20,27 @@ from .filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, filter_interface, get_
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding
 from .techniques import MAX_LAYERS, Technique
 
-# MAX_LIGHTS (the scene format's limit) sizes the Frame uniform's light array (generated into render.wgsl).
+#: The render entry's uniforms (``entry/render.wgsl``): group 0's Frame (camera, view mode, lights; MAX_LIGHTS, the
+#: scene format's limit, sizes its light array) and group 2's Object, generated into the render interface.
+LIGHT = Struct("Light", [
+    ("vector", "vec4f"),  # w = 0: direction towards the light; w = 1: light position
+    ("color", "vec4f"),  # rgb * intensity
+])
+FRAME = Struct("Frame", [
+    ("view_proj", "mat4x4f"),
+    ("camera_pos", "vec4f"),
+    ("light_count", "u32"),
+    ("mode", "u32"),  # render.wgsl's MODE_* constants
+    ("cost_scale", "f32"),  # fetch count shown as full heat in MODE_COST (Technique.cost_scale)
+    ("layer_lo", "f32"),  # MODE_LAYERS grey: (N - layer_lo) / (layer_hi - layer_lo) (Technique.layer_range)
+    ("layer_hi", "f32"),
+    ("lights", array(LIGHT, MAX_LIGHTS)),
+])
+OBJECT = Struct("Object", [
+    ("model", "mat4x4f"),
+    ("normal_matrix", "mat4x4f"),
+    ("uv_scale", "vec4f"),  # xy: texture repeats across the face
+])
 
 
 def trace_params(technique: Technique) -> Struct:
@@ -35,7 +55,8 @@ def interface(technique: Technique, entry: str) -> Generated:
              trace_params(technique).wgsl().rstrip("\n"), f"const MAX_LAYERS: u32 = {MAX_LAYERS}u;",
              *range_constants(technique.params)]
     if entry == "render":
-        lines.append(f"const MAX_LIGHTS: u32 = {MAX_LIGHTS}u;")
+        lines += [f"const MAX_LIGHTS: u32 = {MAX_LIGHTS}u;", FRAME.wgsl_all().rstrip("\n"),
+                  OBJECT.wgsl().rstrip("\n")]
     lines += [f"@group(1) @binding({PARAMS_BINDING}) var<uniform> trace_params: TraceParams;",
               f"@group(1) @binding({SAMPLER_BINDING}) var material_sampler: sampler;"]
     for name in technique.textures:

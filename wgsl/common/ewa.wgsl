@@ -14,10 +14,10 @@
 // texels noticeably: measured in docs/filtering.md); levels floor and floor + 1 blended by the fraction; when
 // their texel estimate (area pi sqrt(F) + 2 (sqrt(A) + sqrt(C)) + 1 each) exceeds max_texels, the level rises
 // until it fits (flagged capped), and the loops stop after max_texels texels in any case.
-// Visibility: texel_hidden (visibility/*.wgsl, chosen by the composer) tests a texel centre. The full method
-// tests every texel; the rows method (seed 003's cheap one) walks each row from its left end until a hidden
-// texel, then from its right end back until a hidden texel, and drops the texels between without testing them.
-// A level whose texels are all hidden falls back to the bilinear value at the hit, which is visible.
+// Visibility: texel_hidden (visibility/*.wgsl, chosen by the composer) tests a texel centre. The full method tests
+// every texel; the rows method (the cheap one of Romanyuk & Dudnyk 2017) walks each row from its left end until a
+// hidden texel, then from its right end back until a hidden texel, and drops the texels between without testing
+// them. A level whose texels are all hidden falls back to the bilinear value at the hit, which is visible.
 // #include "common/ellipse.wgsl"
 // #include "common/wrap.wgsl"
 
@@ -103,7 +103,7 @@ fn ewa_result(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, acc: ptr<functio
     return (*acc).value / (*acc).weight;
 }
 
-// The weighted average over level e; rows: seed 003's row-ends method (visibility filters only).
+// The weighted average over level e; rows: Romanyuk & Dudnyk 2017's row-ends method (visibility filters only).
 fn ewa_average(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, visibility: bool, rows: bool,
                acc: ptr<function, EwaSum>) -> vec4f {
     (*acc).value = vec4f(0.0);

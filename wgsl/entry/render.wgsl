@@ -2,7 +2,8 @@
 // filter's lookups at the hit and the thesis' shading model (ambient 0.2 * albedo, Lambert diffuse,
 // Blinn-Phong 0.2 * pow(., 32)). Composed after the generated interfaces (MAX_LIGHTS among them), one technique
 // file, one filter (`filter_texture`), one derivative source (`texture_derivatives`) and one shading_normal
-// snippet (wgpuviewer/relief/shaders.py). Frame's layout is checked against renderer.FRAME_SIZE by a test.
+// snippet (wgpuviewer/relief/shaders.py). The Frame, Light and Object structs are generated from shaders.FRAME and
+// shaders.OBJECT.
 // #include "common/heat.wgsl"
 // #include "common/footprint.wgsl"
 
@@ -14,31 +15,6 @@ const MODE_UV: u32 = 2u;
 const MODE_DEPTH: u32 = 3u;
 const MODE_LAYERS: u32 = 4u;
 const MODE_ALBEDO: u32 = 5u;  // the filtered albedo, unlit (the filtering study compares it)
-
-struct Light {
-    vector: vec4f,  // w = 0: direction towards the light; w = 1: light position
-    color: vec4f,   // rgb * intensity
-}
-
-struct Frame {
-    view_proj: mat4x4f,
-    camera_pos: vec4f,
-    light_count: u32,
-    mode: u32,
-    cost_scale: f32,  // fetch count shown as full heat in MODE_COST
-    layer_lo: f32,    // MODE_LAYERS grey: (N - layer_lo) / (layer_hi - layer_lo) (renderer.layer_range)
-    layer_hi: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
-    lights: array<Light, MAX_LIGHTS>,
-}
-
-struct Object {
-    model: mat4x4f,
-    normal_matrix: mat4x4f,
-    uv_scale: vec4f,  // xy: texture repeats across the face
-}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(2) @binding(0) var<uniform> object: Object;

@@ -1,9 +1,9 @@
-// Visibility of a footprint texel on a traced relief (seed 003): the texel's surface point is (uv, D(uv)), D
-// bilinear at level 0. The view ray that reaches it enters the surface at uv + D * P (P = V.xy / V.z * S, the
-// pixel's view vector for the whole footprint); the technique's own `trace` follows that ray. The texel is
-// hidden when the ray meets the relief first: hit depth < D - VIS_TOLERANCE. A capped trace proves nothing:
-// the texel is kept (flagged vis_capped). With an exact technique (maxmip, distance) this is the float64
-// reference's test (wgpuviewer/studies/filtering/cpu.py, texel_hidden) to float32 precision.
+// Visibility of a footprint texel on a traced relief (Romanyuk & Dudnyk 2017 (filtering with parallax mapping)):
+// the texel's surface point is (uv, D(uv)), D bilinear at level 0. The view ray that reaches it enters the surface
+// at uv + D * P (P = V.xy / V.z * S, the pixel's view vector for the whole footprint); the technique's own `trace`
+// follows that ray. The texel is hidden when the ray meets the relief first: hit depth < D - VIS_TOLERANCE. A
+// capped trace proves nothing: the texel is kept (flagged vis_capped). With an exact technique (maxmip, distance)
+// this is the float64 reference's test (wgpuviewer/studies/filtering/cpu.py, texel_hidden) to float32 precision.
 
 fn texel_hidden(uv: vec2f, fp: Footprint) -> bool {
     let d = textureSampleLevel(depth_tex, material_sampler, uv, 0.0).r;
