@@ -86,3 +86,13 @@ def test_split_on_and_off():
     assert not s.split and s.side == "A" and s.halves["B"].technique == "pom"
     s.toggle_split()
     assert s.active_side == "A"  # a new split starts on A
+
+
+def test_the_split_draws_two_scissored_passes_that_tile_the_frame():
+    from wgpuviewer.viewer.frames import scene_passes
+
+    assert scene_passes(["a"], None, 100, 50) == [("a", None)]
+    assert scene_passes(["a", "b"], 0.25, 100, 50) == [("a", (0, 0, 25, 50)), ("b", (25, 0, 75, 50))]
+    for split_x in (0.0, 1.0):  # the divider at an edge still leaves each half a column
+        (_, (_, _, left, _)), (_, (x, _, right, _)) = scene_passes(["a", "b"], split_x, 100, 50)
+        assert left >= 1 and right >= 1 and x == left and left + right == 100

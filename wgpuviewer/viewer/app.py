@@ -8,7 +8,9 @@ A HUD (imgui) shows FPS/frame/GPU time, the technique's description and live par
 keys (F1). Edited WGSL files are recompiled on the fly. Settings persist between sessions
 (``settings``). ``keys.CONTROLS`` lists every key.
 
-Runs, interactive or scripted (``--frames``, ``--keys``, ``--screenshot``), go through ``runner``.
+The viewer's parts: ``state`` (what each A/B half shows, the pure key transitions), ``window`` (the toolkit and
+its platform hooks), ``input`` (events), ``builds`` (maps built in the background), ``frames`` (the frame encoder),
+``runner`` (every run, interactive or scripted: ``--frames``, ``--keys``, ``--screenshot``).
 
 The viewer owns what the user tunes live: the parameters of each technique (``params``, starting from the scene's),
 a relief-depth override per technique (``height_scales``), each filter's parameters (``filter_params``) and what each
@@ -31,15 +33,17 @@ from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.core.gpu import get_gpu
 from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, FILTERS, get_filter
 from wgpuviewer.relief.output import save_rgb_png
-from wgpuviewer.relief.renderer import DEPTH_FORMAT, DrawConfig, Renderer
+from wgpuviewer.relief.renderer import DrawConfig, Renderer
 from wgpuviewer.relief.techniques import get_technique
-from wgpuviewer.scene import Camera, Scene
+from wgpuviewer.scene import Scene
 
 from . import runner
-from .builds import MapBuild
+from .builds import Builds
 from .cameras import FlyCamera, OrbitCamera
-from .keys import FLY_KEYS, PRESSED, TECHNIQUE_KEYS
-from .settings import CONFIG_ENV, LIMITS, Settings, save_settings, settings_path
+from .frames import FrameEncoder
+from .input import Input
+from .keys import PRESSED, TECHNIQUE_KEYS
+from .settings import LIMITS, Settings, save_session
 from .state import Half, ViewerState
 from .stats import FrameStats, GpuTimer
 from .window import Window, toolkit
@@ -73,9 +77,8 @@ class Viewer:
         with terminal_progress(f"maps for {technique}") as progress:
             self.renderer.prepare(technique, progress)
         #: Later techniques build on a worker thread while the window draws on (scripted runs: in the frame).
-        self.background = (not scripted) if background is None else background
-        self.build: MapBuild | None = None
-        self.wanted: dict[str, str] = {}  # side -> the technique last asked for there (while building)
+        self.builds = Builds(self.renderer, (not scripted) if background is None else background, show=self._show,
+                             problem=self.problem, shown=lambda side: self.state.halves[side].technique)
         self.problems: list[str] = []  # shown in red in the HUD: a technique that could not be built, ...
         self.problem_time = 0.0
         #: Live parameters per technique (the HUD edits them) and relief-depth overrides per technique.
@@ -93,15 +96,9 @@ class Viewer:
         self.fullscreen = False
         self.messages: list[str] = []
         self.error_range = 2.0
-        self.error_texels = (1, 1)
-        self.held: set[str] = set()
-        self.drag_from: tuple[float, float] | None = None
-        self.dragging_divider = False
         self.frame_size = (0, 0)
         self.scripted = scripted
         self.window = Window(gui, self.gpu, size or (s.width, s.height), scripted=scripted, vsync=self.vsync)
-        self.format = self.window.format
-        self._depth = None
         self._last_time = time.perf_counter()
         self.stats = FrameStats()
         self.timer = GpuTimer(self.gpu.device) if GpuTimer.available(self.gpu) else None
@@ -109,18 +106,14 @@ class Viewer:
 
         self.reloader = ShaderReloader(self.renderer)
         self._shown_errors: list[str] = []
-        self._error = None  # ErrorOverlay, built on first use
-        self._error_key = None
-        self._error_time = -1e9
+        self.frames = FrameEncoder(self.renderer, self.window.format, self.timer)
+        self._want_screenshot = False
         from . import hud as hud_module
 
         self.hud = hud_module.Hud(self) if hud and hud_module.AVAILABLE else None
         if hud and self.hud is None:
             self.message("no HUD: install imgui-bundle (pip install 'wgpuviewer[window]')")
-        self.window.on(self.on_key_down, "key_down")
-        self.window.on(self.on_key_up, "key_up")
-        self.window.on(self.on_pointer, "pointer_down", "pointer_up", "pointer_move")
-        self.window.on(self.on_wheel, "wheel")
+        self.input = Input(self)
         if s.fullscreen:
             self.set_fullscreen(True)
         self._update_title()
@@ -153,7 +146,7 @@ class Viewer:
                 self.problem(f"error view: {error}")
                 return
         self.mode = mode
-        self._error_key = None
+        self.frames.invalidate_error_view()
         self._update_title()
 
     def toggle_mode(self, mode: str):
@@ -180,44 +173,12 @@ class Viewer:
     def set_technique(self, name: str, side: str | None = None):
         """Show ``name`` on the active half (or ``side``) once what it needs is built; until then the half keeps
         its technique. A problem (a bad texture file) is shown in the HUD and the technique stays."""
-        side = side or self.state.side
-        self.wanted[side] = name
-        if self.ready(name):
-            self._show(side, name)
-        elif not self.background:
-            try:
-                self.renderer.prepare(name)
-            except (UserError, InputError) as error:
-                self.problem(str(error))
-                return
-            self._show(side, name)
-        elif self.build is None:
-            self.build = MapBuild(self.renderer, name, side)
+        self.builds.request(side or self.state.side, name)
         self._update_title()
-
-    def ready(self, name: str) -> bool:
-        return not self.renderer.missing(name)
 
     def _show(self, side: str, name: str):
         self.state.show(side, name)
         self._update_title()
-
-    def _poll_build(self):
-        """A finished build: show its technique where it is still wanted, or report its problem; then build
-        what was asked for meanwhile."""
-        build = self.build
-        if build is None or not build.finished:
-            return
-        self.build = None
-        if build.error:
-            self.problem(build.error)
-            if self.wanted.get(build.side) == build.technique:  # not asked for again until a key asks
-                self.wanted[build.side] = self.state.halves[build.side].technique
-        elif self.wanted.get(build.side) == build.technique:
-            self._show(build.side, build.technique)
-        for side, name in self.wanted.items():
-            if self.build is None and not self.ready(name):
-                self.build = MapBuild(self.renderer, name, side)
 
     def problem(self, text: str):
         """A problem the viewer survives (shown in red in the HUD for a while, and on stderr)."""
@@ -244,6 +205,12 @@ class Viewer:
             self.message(f"fullscreen: {problem}")
         else:
             self.fullscreen = on
+
+    def _save_screenshot(self, texture) -> None:
+        try:
+            self.screenshot(texture)
+        except UserError as error:  # e.g. a read-only working folder: say so, keep drawing
+            self.problem(str(error))
 
     def screenshot(self, texture) -> Path:
         stamp = time.strftime("%Y%m%d-%H%M%S")
@@ -329,7 +296,7 @@ class Viewer:
         state = self.state
         state.toggle_split()
         b = state.halves["B"]
-        if state.split and not self.ready(b.technique):  # B draws A's technique until its maps are built
+        if state.split and not self.builds.ready(b.technique):  # B draws A's technique until its maps are built
             wanted = b.technique
             state.show("B", state.halves["A"].technique)
             self.set_technique(wanted, "B")
@@ -364,94 +331,14 @@ class Viewer:
     def quit(self, key: str):
         self.window.close()
 
-    def on_key_down(self, event):
-        key = event["key"]
-        if key in FLY_KEYS:
-            self.held.add(key)
-        else:
-            self.press(key)
-
-    def on_key_up(self, event):
-        self.held.discard(event["key"].lower())  # Shift released first: "D" ends the held "d"
-
-    def _divider_hit(self, x: float) -> bool:
-        width = self.window.logical_size()[0]
-        return self.state.split and abs(x - self.state.split_x * width) <= 8
-
-    def on_pointer(self, event):
-        kind = event["event_type"]
-        if kind == "pointer_down" and event["button"] == 1:
-            if self._divider_hit(event["x"]):
-                self.dragging_divider = True
-            else:
-                self.drag_from = (event["x"], event["y"])
-        elif kind == "pointer_up":
-            self.drag_from = None
-            self.dragging_divider = False
-        elif kind == "pointer_move":
-            if self.dragging_divider:
-                width = max(self.window.logical_size()[0], 1)
-                self.state.split_x = float(np.clip(event["x"] / width, 0.02, 0.98))
-            elif self.drag_from is not None:
-                self.cam.look(event["x"] - self.drag_from[0], event["y"] - self.drag_from[1])
-                self.drag_from = (event["x"], event["y"])
-
-    def on_wheel(self, event):
-        steps = event["dy"] / 100.0
-        if self.camera_mode == "orbit":
-            self.orbit.zoom(steps)
-        else:
-            lo, hi = LIMITS["move_speed"]
-            self.move_speed = float(np.clip(self.move_speed * 1.1 ** (-steps), lo, hi))
-
     def _update_title(self):
         what = " | ".join(f"{h.technique} {h.filter} ({h.derivatives})" for _, h in self.state.shown())
         self.window.set_title(f"wgpuviewer - {self.scene.name} - {what} ({self.mode})")
 
     # --- frames ------------------------------------------------------------------------------
 
-    def _scene_passes(self, w: int, h: int, camera: Camera) -> list:
-        """(DrawConfig, scissor) of the passes that draw the scene: one, or the two halves of A/B."""
-        state = self.state
-        if not state.split:
-            return [(self.draw_config(state.halves["A"]), None)]
-        xs = int(np.clip(round(state.split_x * w), 1, w - 1)) if w > 1 else 1
-        return [(self.draw_config(state.halves["A"]), (0, 0, xs, h)),
-                (self.draw_config(state.halves["B"]), (xs, 0, w - xs, h))]
-
-    def _update_error_view(self, w: int, h: int, camera: Camera, now: float):
-        """Recompute the error map when what it shows changed (at most ~3 times a second)."""
-        from . import error_view
-
-        size = error_view.map_size((w, h))
-        state = self.state
-        draws = [self.draw_config(half) for _, half in state.shown()]
-        key = (size, tuple(draws), state.split and round(state.split_x, 3), camera)
-        if key == self._error_key or (self._error_key is not None and now - self._error_time < 0.3):
-            return
-        if self._error is None:
-            self._error = error_view.ErrorOverlay(self.gpu.device, self.format)
-        # One reference per height-scale override in use (each technique is compared on its own relief).
-        references = {}
-        for draw in draws:
-            if draw.height_scale not in references:
-                references[draw.height_scale] = error_view.reference_render(self.renderer, size, camera,
-                                                                            draw.height_scale)
-
-        def error_of(draw):
-            return error_view.error_map(self.renderer, draw, size, camera, references[draw.height_scale])
-
-        values = error_of(draws[0])
-        if state.split:
-            right = error_of(draws[1])
-            xs = int(round(state.split_x * size[0]))
-            values[:, xs:] = right[:, xs:]
-        self.error_texels = error_view.texel_size(self.renderer)
-        self._error.upload(values)
-        self._error_key, self._error_time = key, now
-
     def draw(self):
-        self._poll_build()
+        self.builds.poll()
         now = time.perf_counter()
         dt, self._last_time = min(now - self._last_time, 0.1), now
         self.stats.tick(now)
@@ -465,66 +352,28 @@ class Viewer:
                 print(f"shader error: {error}", file=sys.stderr)
             if not self._shown_errors:
                 self.message("shaders reloaded")
-        if self.held and self.camera_mode == "fly":
-            step = np.sum([FLY_KEYS[k] for k in self.held], axis=0) * self.move_speed * dt
-            self.fly.move(*step)
+        self.input.fly(dt)
         texture = self.window.current_texture()
         w, h = texture.size[:2]
         if w < 1 or h < 1:
             raise wgpu.DrawCancelled("zero-sized frame")
         self.frame_size = (w, h)
-        device = self.gpu.device
-        if self._depth is None or self._depth.size[:2] != (w, h):
-            self._depth = device.create_texture(
-                label="window:depth", size=(w, h, 1), format=DEPTH_FORMAT, usage="RENDER_ATTACHMENT"
-            )
         camera = self.cam.camera()
+        state = self.state
+        draws = [self.draw_config(half) for _, half in state.shown()]
+        split_x = state.split_x if state.split else None
         if self.mode == "error":
-            self._update_error_view(w, h, camera, now)
-        view = texture.create_view()
-        scene_mode = "cost" if self.mode == "cost" else "color"
-        passes = self._scene_passes(w, h, camera)
-        if self.timer:
-            self.timer.begin_frame()
-        # One submit per scene pass: each pass writes the renderer's frame/params uniforms first.
-        for i, (draw, scissor) in enumerate(passes):
-            encoder = device.create_command_encoder(label="window")
-            writes = self.timer.writes(i == 0, i == len(passes) - 1) if self.timer else None
-            self.renderer.encode(
-                encoder, [view], self._depth.create_view(), (self.format,), draw, camera, (w, h),
-                scene_mode, clear=(i == 0), scissor=scissor, timestamp_writes=writes,
-            )
-            if self.timer and i == len(passes) - 1:
-                self.timer.encode_resolve(encoder)
-            device.queue.submit([encoder.finish()])
-        if self.timer:
-            self.timer.after_submit()
-        encoder = device.create_command_encoder(label="window:overlay")
-        if self.mode == "error" and self._error is not None:
-            self._error.encode(encoder, view, (0, 0, w, h), self.error_range)
-        if getattr(self, "_want_screenshot", False):  # the scene without the HUD
+            self.frames.update_error_view(draws, split_x, (w, h), camera, now)
+        screenshot = None
+        if self._want_screenshot:
             self._want_screenshot = False
-            device.queue.submit([encoder.finish()])
-            try:
-                self.screenshot(texture)
-            except UserError as error:  # e.g. a read-only working folder: say so, keep drawing
-                self.problem(str(error))
-            encoder = device.create_command_encoder(label="window:hud")
-        if self.hud is not None:
-            self.hud.encode(encoder, view)
-        device.queue.submit([encoder.finish()])
+            screenshot = self._save_screenshot
+        self.frames.encode(texture, draws, split_x, camera, self.mode, error_range=self.error_range,
+                           screenshot=screenshot, hud=self.hud)
         return texture
 
     def read_frame(self, texture) -> np.ndarray:
-        w, h = texture.size[:2]
-        raw = self.gpu.device.queue.read_texture(  # wgpu-py pads the rows to 256 bytes itself
-            {"texture": texture, "mip_level": 0, "origin": (0, 0, 0)},
-            {"offset": 0, "bytes_per_row": w * 4, "rows_per_image": h},
-            (w, h, 1),
-        )
-        pixels = np.frombuffer(raw, np.uint8).reshape(h, w, 4)
-        rgb = pixels[:, :, [2, 1, 0]] if self.format.startswith("bgra") else pixels[:, :, :3]
-        return np.ascontiguousarray(rgb)
+        return self.frames.read(texture)
 
     def current_settings(self) -> Settings:
         """What to persist: window size (when not fullscreen), camera and UI choices, scene, technique."""
@@ -541,18 +390,6 @@ class Viewer:
             show_hud=self.show_hud, show_stats=self.show_stats,
             last_scene=str(self.scene.path) if self.scene.path else "", last_technique=self.state.halves["A"].technique,
         )
-
-
-def save_session(settings: Settings) -> None:
-    """Save the settings at the end of a session; a folder that cannot be written is a warning naming it and
-    the variable that moves it, never a failed session."""
-    try:
-        path = save_settings(settings)
-        print(f"settings saved to {path}", file=sys.stderr)
-    except (OSError, UserError) as error:
-        reason = getattr(error, "strerror", None) or str(error)
-        print(f"wgpuviewer: warning: settings not saved: {settings_path()} cannot be written ({reason}); "
-              f"set {CONFIG_ENV} to a writable folder", file=sys.stderr)
 
 
 def run_viewer(

@@ -269,7 +269,7 @@ class Hud:
             top = v.cost_scale()
             labels = ["0", f"{top / 2:g}", f"{top:g}+"]
         else:
-            tw, th = v.error_texels
+            tw, th = v.frames.error_texels
             title = f"UV error vs {v.error_reference} in texels ({tw}x{th} map)"
             labels = ["0", f"{v.error_range / 2:.3g}", f"{v.error_range:.3g}+"]
         draw.add_text((x0, y0 - 18), white, title)
@@ -301,8 +301,8 @@ class Hud:
         problem = v.current_problem()
         if problem:
             lines.append((RED, problem))
-        if v.build is not None:
-            lines.append((YELLOW, v.build.line()))
+        if v.builds.current is not None:
+            lines.append((YELLOW, v.builds.current.line()))
             self.drawn_panels.append("progress")
         lines += [(WHITE, m) for m in v.messages[-3:]]
         if not lines:
