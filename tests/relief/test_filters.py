@@ -286,7 +286,7 @@ def test_at_a_grazing_step_hidden_texels_get_no_weight(gpu):
 
 
 def test_row_ends_method_keeps_the_gain_at_a_step(gpu):
-    """At a straight step the hidden texels of a row are one run, the case seed 003's cheap method assumes: it
+    """At a straight step the hidden texels of a row are one run, the case Romanyuk & Dudnyk 2017's cheap method assumes: it
     gives the full method's value while tracing fewer texels."""
     height, view, uv, dx, dy = step_case()
     texture = textures()["noise 64x48"]
