@@ -57,12 +57,12 @@ def frame():
         viewer.press("5")  # pom: needs the height map, whose data is damaged
     viewer.draw()
     seen["frames"] += 1
-    if viewer.build is not None:
+    if viewer.builds.current is not None:
         seen["while_building"] += 1
     if "progress" in viewer.hud.drawn_panels:
         seen["progress"] += 1
         seen["layout"] = viewer.hud.rects
-    if (seen["pressed"] and viewer.build is None) or seen["frames"] > 3000:
+    if (seen["pressed"] and viewer.builds.current is None) or seen["frames"] > 3000:
         viewer.window.close()
 
 viewer.window.request_draw(frame)
@@ -112,8 +112,7 @@ def test_a_scripted_run_with_a_bad_texture_ends_with_one_line_and_exit_2(scene, 
 
 
 def test_an_unwritable_config_folder_is_a_warning(tmp_path, monkeypatch, capsys):
-    from wgpuviewer.viewer.app import save_session
-    from wgpuviewer.viewer.settings import Settings
+    from wgpuviewer.viewer.settings import Settings, save_session
 
     blocker = tmp_path / "a-file"
     blocker.write_text("")

@@ -49,3 +49,51 @@ class MapBuild:
         seconds = time.perf_counter() - self.started
         step = f"{self.label} ({self.done + 1}/{self.total})" if self.total and self.done < self.total else "…"
         return f"building {self.technique}: {step}, {seconds:.0f} s"
+
+
+class Builds:
+    """The map-build orchestration of the two A/B sides: what each side asked for last (``wanted``) and the one
+    ``MapBuild`` under way (``current``). A technique whose maps are ready is shown at once; otherwise it is built
+    in the background (or in place, ``background`` False: scripted runs) and shown when done, if still wanted."""
+
+    def __init__(self, renderer, background: bool, *, show, problem, shown):
+        """``show(side, name)`` shows a technique, ``problem(text)`` reports one, ``shown(side)`` is the technique
+        a side shows now."""
+        self.renderer, self.background = renderer, background
+        self._show, self._problem, self._shown = show, problem, shown
+        self.current: MapBuild | None = None
+        self.wanted: dict[str, str] = {}
+
+    def ready(self, name: str) -> bool:
+        return not self.renderer.missing(name)
+
+    def request(self, side: str, name: str) -> None:
+        self.wanted[side] = name
+        if self.ready(name):
+            self._show(side, name)
+        elif not self.background:
+            try:
+                self.renderer.prepare(name)
+            except (UserError, InputError) as error:
+                self._problem(str(error))
+                return
+            self._show(side, name)
+        elif self.current is None:
+            self.current = MapBuild(self.renderer, name, side)
+
+    def poll(self) -> None:
+        """A finished build: show its technique where it is still wanted, or report its problem; then build
+        what was asked for meanwhile."""
+        build = self.current
+        if build is None or not build.finished:
+            return
+        self.current = None
+        if build.error:
+            self._problem(build.error)
+            if self.wanted.get(build.side) == build.technique:  # not asked for again until a key asks
+                self.wanted[build.side] = self._shown(build.side)
+        elif self.wanted.get(build.side) == build.technique:
+            self._show(build.side, build.technique)
+        for side, name in self.wanted.items():
+            if self.current is None and not self.ready(name):
+                self.current = MapBuild(self.renderer, name, side)

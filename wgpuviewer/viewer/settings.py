@@ -4,7 +4,8 @@
 ``%APPDATA%\\wgpuviewer`` (Windows), ``~/Library/Application Support/wgpuviewer`` (macOS) or
 ``$XDG_CONFIG_HOME/wgpuviewer`` (default ``~/.config/wgpuviewer``, Linux and others).
 A missing file gives the defaults silently; a corrupt or outdated file, or a bad value, gives the
-defaults (for that value) and a warning, never a crash. Writes are atomic.
+defaults (for that value) and a warning, never a crash. Writes are atomic; a folder that cannot be written is a
+warning at the end of a session (``save_session``).
 """
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ import sys
 import tomllib
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
+
+from wgpuviewer.core.errors import UserError
 
 CONFIG_ENV = "WGPUVIEWER_CONFIG_DIR"
 FILE_NAME = "settings.toml"
@@ -159,3 +162,15 @@ def save_settings(settings: Settings, path: Path | None = None) -> Path:
     with atomic_open(path) as f:
         f.write(dumps(settings).encode("utf-8"))
     return path
+
+
+def save_session(settings: Settings) -> None:
+    """Save the settings at the end of a session; a folder that cannot be written is a warning naming it and
+    the variable that moves it, never a failed session."""
+    try:
+        path = save_settings(settings)
+        print(f"settings saved to {path}", file=sys.stderr)
+    except (OSError, UserError) as error:
+        reason = getattr(error, "strerror", None) or str(error)
+        print(f"wgpuviewer: warning: settings not saved: {settings_path()} cannot be written ({reason}); "
+              f"set {CONFIG_ENV} to a writable folder", file=sys.stderr)

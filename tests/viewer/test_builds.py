@@ -1,0 +1,91 @@
+"""The map-build orchestration of the A/B sides without a GPU: a stand-in renderer whose maps are 'built' by
+``prepare``."""
+
+from __future__ import annotations
+
+import threading
+
+from wgpuviewer.core.errors import InputError
+from wgpuviewer.viewer.builds import Builds
+
+
+class FakeRenderer:
+    def __init__(self, built=(), bad=(), gate: threading.Event | None = None):
+        self.built, self.bad, self.gate = set(built), set(bad), gate
+        self.prepared: list[str] = []
+
+    def missing(self, name):
+        return [] if name in self.built else [f"{name} maps"]
+
+    def prepare(self, name, progress=None):
+        if self.gate is not None:
+            self.gate.wait(10)
+        self.prepared.append(name)
+        if name in self.bad:
+            raise InputError(f"{name}: damaged texture")
+        self.built.add(name)
+
+
+def builds_for(renderer, background):
+    shown = {"A": "normal", "B": "normal"}
+    problems: list[str] = []
+    builds = Builds(renderer, background, show=shown.__setitem__, problem=problems.append, shown=shown.__getitem__)
+    return builds, shown, problems
+
+
+def test_a_ready_technique_shows_at_once_and_a_missing_one_is_built_in_place_without_background():
+    renderer = FakeRenderer(built={"normal", "parallax"})
+    builds, shown, problems = builds_for(renderer, background=False)
+    builds.request("A", "parallax")
+    assert shown["A"] == "parallax" and renderer.prepared == []
+    builds.request("B", "pom")
+    assert shown == {"A": "parallax", "B": "pom"} and renderer.prepared == ["pom"] and builds.current is None
+    builds.request("A", "relief")
+    renderer.bad.add("cone")
+    builds.request("A", "cone")
+    assert shown["A"] == "relief" and problems == ["cone: damaged texture"]
+
+
+def test_a_background_build_shows_its_technique_when_done_if_still_wanted():
+    gate = threading.Event()
+    renderer = FakeRenderer(built={"normal"}, gate=gate)
+    builds, shown, problems = builds_for(renderer, background=True)
+    builds.request("A", "pom")
+    assert builds.current is not None and shown["A"] == "normal"  # the side keeps its technique meanwhile
+    builds.request("B", "relief")  # one build at a time: relief waits
+    builds.poll()
+    assert shown == {"A": "normal", "B": "normal"}
+    gate.set()
+    assert builds.current.wait(10)
+    builds.poll()  # pom is shown; relief, asked for meanwhile, starts
+    assert shown["A"] == "pom" and builds.current is not None and builds.current.technique == "relief"
+    assert builds.current.wait(10)
+    builds.poll()
+    assert shown == {"A": "pom", "B": "relief"} and builds.current is None and problems == []
+
+
+def test_a_failed_background_build_is_reported_and_not_retried_until_asked_again():
+    renderer = FakeRenderer(built={"normal"}, bad={"pom"})
+    builds, shown, problems = builds_for(renderer, background=True)
+    builds.request("A", "pom")
+    assert builds.current.wait(10)
+    builds.poll()
+    assert problems == ["pom: damaged texture"] and shown["A"] == "normal"
+    assert builds.wanted["A"] == "normal" and builds.current is None
+    builds.poll()
+    assert renderer.prepared == ["pom"]  # not built again by itself
+    builds.request("A", "pom")
+    assert builds.current is not None and builds.current.wait(10)
+    assert renderer.prepared == ["pom", "pom"]
+
+
+def test_a_build_no_longer_wanted_is_not_shown():
+    gate = threading.Event()
+    renderer = FakeRenderer(built={"normal", "parallax"}, gate=gate)
+    builds, shown, _ = builds_for(renderer, background=True)
+    builds.request("A", "pom")
+    builds.request("A", "parallax")  # ready: shown at once, pom is no longer wanted there
+    gate.set()
+    assert builds.current.wait(10)
+    builds.poll()
+    assert shown["A"] == "parallax" and builds.current is None
