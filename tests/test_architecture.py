@@ -1,11 +1,15 @@
 """The rooms and their rules (docs/architecture.md): who may import whom, no import cycles, a docstring per room,
-and the README's keys table generated from the viewer's one key table."""
+and the README's keys, technique, filter and map-kind tables generated from their one source."""
 
 from __future__ import annotations
 
 import ast
 from pathlib import Path
 
+import pytest
+
+from maptools import registry as map_registry
+from wgpuviewer.relief import filters, techniques
 from wgpuviewer.viewer.keys import markdown_table
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -122,3 +126,18 @@ def test_every_room_says_what_lives_there_and_what_it_may_import():
 
 def test_readme_keys_table_is_the_key_table():
     assert markdown_table() in (ROOT / "README.md").read_text()
+
+
+def generated_section(text: str, name: str) -> str:
+    """The README's text between `<!-- generated: NAME -->` and the next `<!-- end generated -->`."""
+    begin = f"<!-- generated: {name} -->"
+    assert text.count(begin) == 1, f"README.md needs exactly one {begin!r} marker"
+    return text.split(begin, 1)[1].split("<!-- end generated -->", 1)[0].strip()
+
+
+@pytest.mark.parametrize("name, table", [("techniques", techniques.markdown_table), ("filters", filters.markdown_table),
+                                         ("map kinds", map_registry.markdown_table)])
+def test_readme_registry_tables_are_generated(name, table):
+    """The README's technique, filter and map-kind tables are exactly what the registries generate (regenerate them
+    with e.g. `python -c "from wgpuviewer.relief.techniques import markdown_table; print(markdown_table())"`)."""
+    assert generated_section((ROOT / "README.md").read_text(), name) == table().strip()
