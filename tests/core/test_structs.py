@@ -111,6 +111,19 @@ def test_pack_unpack_round_trip():
         RECORD.unpack(data, 3)
 
 
+def test_an_array_of_structs_takes_records_of_the_element_dtype_as_is():
+    light = Struct("L", [("vector", "vec4f"), ("color", "vec4f")])
+    frame = Struct("F", [("count", "u32"), ("lights", array(light, 3))])
+    records = np.zeros(3, light.dtype)
+    records["color"][1] = [1, 2, 3, 0]
+    as_array = frame.pack({"count": 2, "lights": records})
+    as_mappings = frame.pack({"count": 2, "lights": [{"vector": r["vector"], "color": r["color"]} for r in records]})
+    assert as_array == as_mappings
+    assert frame.unpack(as_array)["lights"][0, 1]["color"].tolist() == [1, 2, 3, 0]
+    other = Struct("M", [("vector", "vec4f"), ("color", "vec4i")])
+    with pytest.raises(ValueError, match="takes L records"):
+        frame.pack({"count": 2, "lights": np.zeros(3, other.dtype)})
+
 def test_defaults_and_padded_f32_uniforms():
     params = f32_uniform("Params", ["a", "b", "c", "d", "e"])
     assert params.names == ("a", "b", "c", "d", "e", "_pad0", "_pad1", "_pad2") and params.size == 32

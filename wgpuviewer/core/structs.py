@@ -220,6 +220,12 @@ class Struct:
             elif isinstance(t, ArrayType) and isinstance(t.element, Struct):
                 if len(value) != t.count:
                     raise ValueError(f"struct {self.name}: field {n!r} takes {t.count} records, not {len(value)}")
+                if isinstance(value, np.ndarray):  # records already in the element's layout: one copy, no loop
+                    if value.dtype != t.element.dtype:
+                        raise ValueError(f"struct {self.name}: field {n!r} takes {t.element.name} records, "
+                                         f"not dtype {value.dtype}")
+                    record[n] = value
+                    continue
                 for i, item in enumerate(value):
                     t.element._fill(record[n][..., i], item)
             elif isinstance(t, ArrayType) and _dtype(t).base.shape != _dtype(t.element).shape:

@@ -39,7 +39,7 @@ from .filters import (
 )
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
 from .probe import probe
-from .shaders import FRAME, MAX_LIGHTS, OBJECT, compose_technique, pack_trace_params, trace_params_size
+from .shaders import FRAME, LIGHT, MAX_LIGHTS, OBJECT, compose_technique, pack_trace_params, trace_params_size
 from .techniques import Technique, get_technique, resolve_params
 
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
@@ -153,6 +153,7 @@ class Renderer:
             )
             self._samplers: dict[tuple, wgpu.GPUSampler] = {}
         self._frame_buffer = device.create_buffer(label="frame", size=FRAME.size, usage=U.UNIFORM | U.COPY_DST)
+        self._lights = scene_lights(scene)  # fixed for the scene: packed once, not per frame
         self._frame_group = device.create_bind_group(
             layout=self._frame_layout, entries=[{"binding": 0, "resource": {"buffer": self._frame_buffer}}]
         )
@@ -388,18 +389,11 @@ class Renderer:
         view_proj = cam.perspective(camera.fov, w / h, camera.near, camera.far) @ cam.look_at(
             camera.position, camera.target, camera.up
         )
-        lights = [{"vector": np.zeros(4), "color": np.zeros(4)} for _ in range(MAX_LIGHTS)]
-        for slot, light in zip(lights, self.scene.lights):  # the scene checked the count (MAX_LIGHTS)
-            if light.kind == "directional":
-                slot["vector"] = [*(-np.asarray(light.direction)), 0.0]  # towards the light
-            else:
-                slot["vector"] = [*light.position, 1.0]
-            slot["color"] = [*(np.asarray(light.color) * light.intensity), 0.0]
         lo, hi = technique.layer_range(params)
         data = FRAME.pack({"view_proj": cam.to_wgsl(view_proj), "camera_pos": [*camera.position, 0.0],
                            "light_count": len(self.scene.lights), "mode": MODES[mode],
                            "cost_scale": technique.cost_scale(params), "layer_lo": lo, "layer_hi": hi,
-                           "lights": lights})
+                           "lights": self._lights})
         self.gpu.device.queue.write_buffer(self._frame_buffer, 0, data)
 
     def encode(
@@ -512,6 +506,18 @@ def _reported_against_height(material, kind: str):
         if ref is None or not ref.origin:
             raise
         raise ref.error(f"its {kind} map cannot be built: {error}") from None
+
+
+def scene_lights(scene) -> np.ndarray:
+    """The Frame uniform's light records (LIGHT, MAX_LIGHTS of them; unused ones zero) for ``scene``'s lights."""
+    lights = np.zeros(MAX_LIGHTS, LIGHT.dtype)
+    for i, light in enumerate(scene.lights):  # the scene checked the count (MAX_LIGHTS)
+        if light.kind == "directional":
+            lights["vector"][i] = [*(-np.asarray(light.direction)), 0.0]  # towards the light
+        else:
+            lights["vector"][i] = [*light.position, 1.0]
+        lights["color"][i] = [*(np.asarray(light.color) * light.intensity), 0.0]
+    return lights
 
 
 def _read_texture(device, texture, channels: int, dtype) -> np.ndarray:
