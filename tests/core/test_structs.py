@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from wgpuviewer.core.compute import compute_for
-from wgpuviewer.core.structs import Struct, array, f32_literal, f32_uniform, range_constants
+from wgpuviewer.core.structs import Struct, array, f32_literal, range_constants, scalar_literal, scalar_uniform
 from wgpuviewer.core.wgsl import compose
 
 LIGHT = Struct("Light", [("position", "vec3f"), ("radius", "f32"), ("color", "vec3f")])
@@ -124,15 +124,22 @@ def test_an_array_of_structs_takes_records_of_the_element_dtype_as_is():
     with pytest.raises(ValueError, match="takes L records"):
         frame.pack({"count": 2, "lights": np.zeros(3, other.dtype)})
 
-def test_defaults_and_padded_f32_uniforms():
-    params = f32_uniform("Params", ["a", "b", "c", "d", "e"])
-    assert params.names == ("a", "b", "c", "d", "e", "_pad0", "_pad1", "_pad2") and params.size == 32
-    assert np.array_equal(np.frombuffer(params.pack(dict(a=1, b=2, c=3, d=4, e=5)), np.float32),
-                          [1, 2, 3, 4, 5, 0, 0, 0])
-    assert f32_uniform("Empty", []).names == ("_unused", "_pad0", "_pad1", "_pad2")
-    assert f32_uniform("Empty", []).pack({}) == bytes(16)
+def test_defaults_and_padded_scalar_uniforms():
+    params = scalar_uniform("Params", [("a", "f32"), ("n", "u32"), ("k", "i32"), ("flag", "u32"), ("e", "f32")])
+    assert params.names == ("a", "n", "k", "flag", "e", "_pad0", "_pad1", "_pad2") and params.size == 32
+    assert params.wgsl() == ("struct Params {\n    a: f32,\n    n: u32,\n    k: i32,\n    flag: u32,\n    e: f32,\n"
+                             "    _pad0: u32,\n    _pad1: u32,\n    _pad2: u32,\n}\n")
+    data = params.pack(dict(a=0.5, n=16, k=-2, flag=True, e=3))
+    # each value in its field's own type, not a float's bits
+    assert np.frombuffer(data, np.uint32)[[1, 3, 5, 6, 7]].tolist() == [16, 1, 0, 0, 0]
+    assert np.frombuffer(data, np.int32)[2] == -2
+    assert np.frombuffer(data, np.float32)[[0, 4]].tolist() == [0.5, 3.0]
+    assert scalar_uniform("Empty", []).names == ("_unused", "_pad0", "_pad1", "_pad2")
+    assert scalar_uniform("Empty", []).pack({}) == bytes(16)
     with pytest.raises(ValueError, match="no value for field 'e'"):
-        params.pack(dict(a=1, b=2, c=3, d=4))
+        params.pack(dict(a=1, n=2, k=3, flag=0))
+    with pytest.raises(ValueError, match="field 'v' is 'vec2f'; a scalar uniform takes f32, u32, i32"):
+        scalar_uniform("S", [("v", "vec2f")])
     with pytest.raises(ValueError, match="not a field"):
         Struct("S", [("a", "f32")], defaults={"b": 0})
 
@@ -140,12 +147,22 @@ def test_defaults_and_padded_f32_uniforms():
 def test_constants():
     assert f32_literal(2) == "2.0" and f32_literal(0.25) == "0.25" and f32_literal(1e-7) == "1e-07"
 
-    class P:
-        def __init__(self, name, kind, lo, hi):
-            self.name, self.kind, self.min, self.max = name, kind, lo, hi
+    assert scalar_literal(3, "u32") == "3u" and scalar_literal(-8, "i32") == "-8i" and scalar_literal(2, "f32") == "2.0"
+    for value, wgsl_type in ((-1, "u32"), (2.5, "i32"), (True, "u32")):
+        with pytest.raises(ValueError, match=f"is not a {wgsl_type} value"):
+            scalar_literal(value, wgsl_type)
+    with pytest.raises(ValueError, match="not a scalar type"):
+        scalar_literal(1, "vec2u")
 
-    assert range_constants([P("layers", int, 4, 64), P("flag", bool, 0, 1)]) == [
-        "const LAYERS_MIN: f32 = 4.0;", "const LAYERS_MAX: f32 = 64.0;"]
+    class P:
+        def __init__(self, name, kind, lo, hi, wgsl_type):
+            self.name, self.kind, self.min, self.max, self.wgsl_type = name, kind, lo, hi, wgsl_type
+
+    # the bounds in the parameter's own type, so WGSL clamps it without a conversion; none for a flag
+    assert range_constants([P("layers", int, 4, 64, "u32"), P("offset", int, -8, 8, "i32"), P("alpha", float, 1.6, 8, "f32"),
+                            P("flag", bool, 0, 1, "u32")]) == [
+        "const LAYERS_MIN: u32 = 4u;", "const LAYERS_MAX: u32 = 64u;", "const OFFSET_MIN: i32 = -8i;",
+        "const OFFSET_MAX: i32 = 8i;", "const ALPHA_MIN: f32 = 1.6;", "const ALPHA_MAX: f32 = 8.0;"]
 
 
 WRITE = """@group(0) @binding(0) var<storage, read_write> out: array<Record>;

@@ -42,7 +42,7 @@ def test_registry_entry_and_map_slot():
     tech = TECHNIQUES["cone"]
     assert tech.ray_search and tech.exact and tech.wgsl_file == "techniques/cone.wgsl" and "cone" in tech.textures
     assert tech.defaults() == {"iterations": 128}
-    assert dict(tech.fixed) == {"max_ratio": CONE_MAX_RATIO, "halvings_max": CONE_HALVINGS_MAX,
+    assert tech.fixed_values() == {"max_ratio": CONE_MAX_RATIO, "halvings_max": CONE_HALVINGS_MAX,
                                 "finish_cells": CONE_FINISH_CELLS}
     assert tech.fetch_bound({"iterations": 10}) == 20 + CONE_HALVINGS_MAX + CONE_FINISH_CELLS
     assert MAP_SLOTS["cone"].derived and not MAP_SLOTS["cone"].scale_bound

@@ -8,11 +8,10 @@ import re
 import numpy as np
 import pytest
 
-from tests.relief.test_interface import layout
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.wgsl import read_wgsl
 from wgpuviewer.relief import filters
-from wgpuviewer.relief.filter_probe import OUT_STRIDE, SAMPLE_STRIDE, filter_probe, texture_levels
+from wgpuviewer.relief.filter_probe import filter_probe, texture_levels
 from wgpuviewer.relief.filters import FILTERS, FLAGS
 from wgpuviewer.relief.reference import exact_hit, view_dir_from_angles
 from wgpuviewer.studies.filtering import cpu
@@ -72,21 +71,20 @@ def test_anisotropic_samplers_filter_linearly():
 def test_generated_filter_interface_follows_the_registry():
     for f in FILTERS.values():
         text = filters.filter_interface(f).text
-        fields = re.findall(r"^    (\w+): f32,$", text, re.M)
-        assert fields[: len(f.params)] == [p.name for p in f.params]
+        fields = re.findall(r"^    (\w+): ([fiu]32),$", text, re.M)
+        assert fields[: len(f.params)] == [(p.name, p.wgsl_type) for p in f.params]
         assert len(fields) * 4 == filters.filter_uniform_size(f) and filters.filter_uniform_size(f) % 16 == 0
         assert len(filters.pack_filter_params(f, f.defaults())) == filters.filter_uniform_size(f)
         for p in f.params:
-            assert f"const {p.name.upper()}_MAX: f32 = " in text
+            assert f"const {p.name.upper()}_MAX: {p.wgsl_type} = " in text
         for name, bit in FLAGS.items():
             assert f"const FLAG_{name.upper()}: u32 = {bit}u;" in text
         assert f"@group({filters.FILTER_GROUP}) @binding(0) var<uniform> filter_params: FilterParams;" in text
-
-
-def test_filter_probe_structs_match_the_probe():
-    source = read_wgsl("entry/filter_probe.wgsl")
-    assert layout(source, "FilterSample", {})[0] == SAMPLE_STRIDE
-    assert layout(source, "FilterOut", {})[0] == OUT_STRIDE
+    # counts u32, numbers f32, packed in those types
+    ewa = filters.filter_params(FILTERS["ewa"])
+    assert ewa.fields[:2] == (("max_texels", "u32"), ("alpha", "f32"))
+    record = ewa.unpack(filters.pack_filter_params(FILTERS["ewa"], {"max_texels": 64}))[0]
+    assert (record["max_texels"], record["alpha"]) == (64, 6.0)
 
 
 def test_unknown_names_are_user_errors():

@@ -1,8 +1,9 @@
 """One source of truth for the GPU interface: the registry and core.structs generate what WGSL must agree on
 (TraceParams, the render entry's Frame and Object, the parameter constants, the binding lines of a technique's
-texture slots); what stays hand-written in WGSL (ProbeRay, ProbeHit, DataOut) is checked here against the Python
-side. And a throw-away technique with a new
-parameter and a new map slot renders and probes without touching any other file."""
+texture slots, the entries' own records: the probe's rays and hits, the filter probe's samples and results, the
+error view's Blit, the offscreen targets' DataOut), and the entry files declare none of them. A throw-away technique
+with a new parameter and a new map slot renders and probes without touching any other file, its hits read back
+field by field where the GPU wrote them."""
 
 from __future__ import annotations
 
@@ -13,53 +14,22 @@ import pytest
 
 from tests.relief.scenes import plane_scene
 from wgpuviewer.core.gpu import create_texture
+from wgpuviewer.core.structs import FragmentOutputs
 from wgpuviewer.core.wgsl import read_wgsl
-from wgpuviewer.relief import maps, probe, renderer, shaders
+from wgpuviewer.relief import filter_probe, maps, probe, renderer, shaders
 from wgpuviewer.relief.maps import MAP_SLOTS, MapSlot
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.relief.techniques import TECHNIQUES, Param, Technique
 from wgpuviewer.scene import parse_scene
+from wgpuviewer.viewer import error_view
 
-# --- WGSL memory layout of hand-written structs (WGSL spec, "Alignment and Size") ------------------------------
-
-_SCALAR = {"f32": (4, 4), "u32": (4, 4), "i32": (4, 4)}
-_VEC = {"2": (8, 8), "3": (12, 16), "4": (16, 16)}
-
-
-def _round_up(x: int, k: int) -> int:
-    return -(-x // k) * k
-
-
-def struct_fields(source: str, name: str) -> list[tuple[str, str]]:
-    body = re.search(rf"struct {name} \{{(.*?)\}}", source, re.S).group(1)
-    fields = []
-    for line in body.splitlines():
-        line = line.split("//")[0].strip().rstrip(",")
-        if line:
-            attrs, _, decl = line.rpartition(")") if line.startswith("@") else ("", "", line)
-            field, _, wgsl_type = decl.partition(":")
-            fields.append((field.strip(), wgsl_type.strip()))
-    return fields
-
-
-def layout(source: str, wgsl_type: str, constants: dict) -> tuple[int, int]:
-    """(size, align) of a WGSL type in a uniform/storage buffer."""
-    if wgsl_type in _SCALAR:
-        return _SCALAR[wgsl_type]
-    if m := re.fullmatch(r"vec([234])([fiu])", wgsl_type):
-        return _VEC[m.group(1)]
-    if wgsl_type == "mat4x4f":
-        return 64, 16
-    if m := re.fullmatch(r"array<(\w+), (\w+)>", wgsl_type):
-        size, align = layout(source, m.group(1), constants)
-        count = int(constants.get(m.group(2), m.group(2)))
-        return count * _round_up(size, align), align
-    offset, align = 0, 1
-    for _, field_type in struct_fields(source, wgsl_type):
-        size, a = layout(source, field_type, constants)
-        offset = _round_up(offset, a) + size
-        align = max(align, a)
-    return _round_up(offset, align), align
+#: Every entry file and the records Python generates for it (composed in before it: the entry never declares them).
+ENTRY_RECORDS = {
+    "entry/render.wgsl": (shaders.FRAME, shaders.OBJECT, renderer.DATA_OUT),
+    "entry/probe.wgsl": (probe.PROBE_RAY, probe.PROBE_HIT),
+    "entry/filter_probe.wgsl": (filter_probe.FILTER_SAMPLE, filter_probe.FILTER_OUT),
+    "entry/error_view.wgsl": (error_view.BLIT,),
+}
 
 
 def test_render_uniforms_are_generated():
@@ -71,22 +41,31 @@ def test_render_uniforms_are_generated():
     text = shaders.interface(TECHNIQUES["pom"], "render").text
     assert shaders.FRAME.wgsl_all() in text and shaders.OBJECT.wgsl() in text
     assert "struct " not in shaders.interface(TECHNIQUES["pom"], "probe").text.replace("struct TraceParams", "")
-    assert not re.search(r"struct (Frame|Light|Object) ", read_wgsl("entry/render.wgsl"))
 
 
-def test_probe_structs_match_the_probe():
-    source = read_wgsl("entry/probe.wgsl")
-    assert layout(source, "ProbeRay", {})[0] == probe.RAY_STRIDE
-    assert layout(source, "ProbeHit", {})[0] == probe.HIT_STRIDE
-    # The probe unpacks ProbeHit by position: uv (2 f32), depth (f32), fetches, capped, layers (u32).
-    assert [t for _, t in struct_fields(source, "ProbeHit")][:6] == ["vec2f", "f32", "u32", "u32", "u32", "u32"]
+@pytest.mark.parametrize("entry", ENTRY_RECORDS)
+def test_entry_files_declare_no_generated_record(entry):
+    source = read_wgsl(entry)
+    for record in ENTRY_RECORDS[entry]:
+        assert not re.search(rf"struct {record.name}\b", source), record.name
 
 
-def test_data_out_matches_the_offscreen_targets():
-    fields = struct_fields(read_wgsl("entry/render.wgsl"), "DataOut")
-    assert [t for _, t in fields] == ["vec4f", "vec4u", "u32", "vec4u"]
-    assert renderer.OFFSCREEN_FORMATS == (
-        "rgba8unorm-srgb", "rgba32uint", "r32uint", "rgba32uint")  # 4 floats, 4 x u32, 1 x u32, 4 x u32
+def test_data_out_is_generated_from_the_offscreen_targets():
+    """fs_data's outputs and the offscreen formats are one list: location = position, each type fit for its
+    format (WebGPU's sample type and channel rule, refused by name otherwise)."""
+    assert renderer.OFFSCREEN_FORMATS == renderer.DATA_OUT.formats == (
+        renderer.COLOR_FORMAT, renderer.DATA_FORMAT, renderer.LAYERS_FORMAT, renderer.FILTER_FORMAT)
+    assert renderer.DATA_OUT.wgsl() == ("struct DataOut {\n    @location(0) color: vec4f,\n"
+                                        "    @location(1) data: vec4u,\n    @location(2) layers: u32,\n"
+                                        "    @location(3) filtering: vec4u,\n}\n")
+    FragmentOutputs("Fine", [("a", "vec4f", "bgra8unorm-srgb"), ("b", "vec2i", "rg16sint"), ("c", "u32", "r8uint")])
+    for target, words in [(("a", "vec2f", "rgba8unorm"), "needs f32 with at least 4 components"),
+                          (("a", "vec4f", "rgba32uint"), "needs u32"),
+                          (("a", "vec4u", "r32sint"), "needs i32"),
+                          (("a", "f32", "depth32float"), "not a colour format"),
+                          (("a", "mat4x4f", "rgba8unorm"), "a scalar or vector")]:
+        with pytest.raises(ValueError, match=f"fragment outputs Bad: 'a' \\({target[1]}\\) to {target[2]}: .*{words}"):
+            FragmentOutputs("Bad", [target])
 
 
 def test_generated_interface_follows_the_registry():
@@ -98,7 +77,7 @@ def test_generated_interface_follows_the_registry():
         assert len(shaders.pack_trace_params(t, 1.0, (4, 4), {})) == params.size
         for p in t.params:
             if p.kind is not bool:
-                assert f"const {p.name.upper()}_MAX: f32 = " in text
+                assert f"const {p.name.upper()}_MAX: {p.wgsl_type} = " in text
         for name in t.textures:
             slot = MAP_SLOTS[name]
             assert f"@group(1) @binding({maps.binding(name)}) var {slot.wgsl_name}: {slot.wgsl_type};" in text
@@ -108,14 +87,15 @@ def test_generated_interface_follows_the_registry():
 
 # --- a throw-away technique: new parameter, new map slot, no other file touched --------------------------------
 
-TOY_WGSL = """// A throw-away technique: the hit is the entry uv moved along u by gain * the toy map's value.
+TOY_WGSL = """// A throw-away technique: the hit is the entry uv moved along u by gain * the toy map's value, at the
+// depth map's depth, after 1 fetch and 3 layers, capped where the view grazes.
 // #include "common/depth.wgsl"
 
 fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     fetch_count = 0u;
     let d = depth_at(uv0, lod);
     let shift = clamp(trace_params.gain, GAIN_MIN, GAIN_MAX) * textureSampleLevel(toy_tex, material_sampler, uv0, 0.0).r;
-    return TraceResult(uv0 + vec2f(shift, 0.0), d, fetch_count, is_grazing(v), 0u);
+    return TraceResult(uv0 + vec2f(shift, 0.0), d, fetch_count, is_grazing(v), 3u);
 }
 """
 
@@ -139,9 +119,13 @@ def toy(tmp_path, monkeypatch):
 def test_a_new_technique_with_a_new_parameter_and_map_renders_and_probes(gpu, toy):
     rng = np.random.default_rng(0)
     uv = rng.random((64, 2))
-    got = probe.probe("toy", np.full((32, 32), 0.5), uv, [0.0, 0.0, 1.0], 0.05, gain=2.0)
+    grazing = np.arange(64) % 3 == 0
+    view = np.where(grazing[:, None], [1.0, 0.0, 0.0], [0.0, 0.6, 0.8])
+    got = probe.probe("toy", np.full((32, 32), 0.25), uv, view, 0.05, gain=2.0)
+    # Every field of ProbeRay and ProbeHit where the GPU reads and writes it: the generated layout.
     np.testing.assert_allclose(got.uv, uv + [0.5, 0.0], atol=1e-6)  # 2.0 * 0.25
-    assert (got.fetches == 1).all()
+    np.testing.assert_allclose(got.depth, 0.75, atol=1e-4)  # depth = 1 - height (a 16-bit map holds it to 2e-5)
+    assert (got.fetches == 1).all() and (got.layers == 3).all() and (got.capped == grazing).all()
 
     scene = parse_scene(plane_scene("toy", "gain = 0.5", position=(0.0, 0.8, 0.2), map_size=32))
     assert scene.technique_params["toy"] == {"gain": 0.5}

@@ -19,7 +19,8 @@ from wgpuviewer.relief.output import OUTPUT_MODES, mode_data, mode_picture
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
 from wgpuviewer.relief.renderer import Renderer
-from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS, TECHNIQUES
+from wgpuviewer.relief.shaders import pack_trace_params, trace_params
+from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS, TECHNIQUES, Fixed
 from wgpuviewer.scene import default_scene_path, load_scene, parse_scene
 from wgpuviewer.textures import builtin_height
 
@@ -208,7 +209,7 @@ def test_distance_refined_uses_the_same_tracer():
     plain, refined = TECHNIQUES["distance"], TECHNIQUES["distance_refined"]
     assert plain.wgsl_file == refined.wgsl_file == "techniques/distance.wgsl"
     assert plain.params == refined.params
-    p, r = dict(plain.fixed), dict(refined.fixed)
+    p, r = plain.fixed_values(), refined.fixed_values()
     assert p == {"sectors": 1, "bands": 1, "steep_cos": -2, "volumes": 1}
     assert r == {"sectors": REFINED_SECTORS, "bands": REFINED_BANDS, "volumes": REFINED_SECTORS * REFINED_BANDS + 1,
                  "steep_cos": pytest.approx(math.cos(math.radians(REFINED_MAX_ANGLE)))}
@@ -366,6 +367,31 @@ def test_the_renderer_marches_the_materials_range(gpu, tmp_path):
     assert np.allclose((lo, hi), depth_range(1.0 - height, gpu.depth_format), atol=1e-4)  # (16-bit PNG)
     k = (depth - lo) / ((hi - lo) / 8)
     assert depth.size > 500 and np.abs(k - np.round(k)).max() < 1e-3 and k.min() > -1e-3
+
+
+def test_trace_params_fields_have_their_declared_types():
+    """TraceParams holds every value in its own WGSL type, from the declarations: an integer parameter u32 (i32 where
+    its range goes below 0), a flag u32, a number f32; fixed values as declared; the depth map's size u32."""
+    types = {name: dict(t.trace_field_types) for name, t in TECHNIQUES.items()}
+    for t in types.values():
+        assert {k: t[k] for k in ("height_scale", "depth_width", "depth_height", "depth_min", "depth_max")} == {
+            "height_scale": "f32", "depth_width": "u32", "depth_height": "u32", "depth_min": "f32", "depth_max": "f32"}
+    assert types["pom"]["layers"] == types["relief"]["binary_steps"] == types["parallax"]["offset_limiting"] == "u32"
+    assert types["quadmax"]["top_offset"] == types["quadmax_pom"]["top_offset"] == "i32"
+    assert types["auto"]["max_error"] == "f32" and types["auto"]["budget_log2_min"] == "i32"
+    assert types["cone"]["max_ratio"] == "f32" and types["cone"]["halvings_max"] == types["distance"]["volumes"] == "u32"
+    assert "    top_offset: i32,\n    max_steps: u32,\n" in trace_params(TECHNIQUES["quadmax"]).wgsl()
+    # packed in those types: integers as integers, not as a float's bits
+    record = trace_params(TECHNIQUES["quadmax"]).unpack(
+        pack_trace_params(TECHNIQUES["quadmax"], 0.25, (8, 16), {"top_offset": -3, "max_steps": 7}, (0.125, 0.75)))[0]
+    assert (record["top_offset"], record["max_steps"], record["depth_width"], record["depth_height"]) == (-3, 7, 16, 8)
+    assert (record["height_scale"], record["depth_min"], record["depth_max"]) == (0.25, 0.125, 0.75)
+    flags = trace_params(TECHNIQUES["pom_adaptive"]).unpack(
+        pack_trace_params(TECHNIQUES["pom_adaptive"], 0.1, (4, 4), {"angle_only": True}))[0]
+    assert (flags["angle_only"], flags["min_layers"], flags["max_layers"]) == (1, 4, 32)
+    for value, wgsl_type in ((2.5, "u32"), (-1, "u32"), (1.0, "i32"), (1, "vec2f")):
+        with pytest.raises(ValueError, match="fixed value 'n'"):
+            Fixed("n", value, wgsl_type)
 
 
 def test_markdown_table_has_a_row_per_technique():

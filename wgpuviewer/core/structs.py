@@ -258,13 +258,20 @@ class Struct:
         return np.frombuffer(buffer[: count * self.size], self.dtype).copy()
 
 
-def f32_uniform(name: str, fields: Sequence[str], pad_to: int = 16) -> Struct:
-    """A uniform of f32 ``fields`` (at least one: ``_unused``), padded with zeroed ``_padN`` fields to a multiple of
-    ``pad_to`` bytes (the technique and filter parameter records)."""
-    names = list(fields) or ["_unused"]
-    pads = [f"_pad{i}" for i in range(-len(names) % (pad_to // 4))]
-    return Struct(name, [(n, "f32") for n in names + pads], "uniform",
-                  defaults={n: 0.0 for n in pads + (["_unused"] if not fields else [])})
+#: The scalar types of ``scalar_uniform`` fields (and of ``scalar_literal``).
+SCALARS = ("f32", "u32", "i32")
+
+
+def scalar_uniform(name: str, fields: Sequence[tuple[str, str]], pad_to: int = 16) -> Struct:
+    """A uniform of scalar ``fields`` ((name, "f32" | "u32" | "i32") pairs; at least one: ``_unused``), padded with
+    zeroed u32 ``_padN`` fields to a multiple of ``pad_to`` bytes (the technique and filter parameter records)."""
+    fields = list(fields)
+    for n, t in fields:
+        if not (isinstance(t, str) and t in SCALARS):
+            raise ValueError(f"struct {name}: field {n!r} is {t!r}; a scalar uniform takes {', '.join(SCALARS)}")
+    unused = [] if fields else [("_unused", "u32")]
+    pads = [(f"_pad{i}", "u32") for i in range(-len(fields + unused) % (pad_to // 4))]
+    return Struct(name, fields + unused + pads, "uniform", defaults={n: 0 for n, _ in unused + pads})
 
 
 def f32_literal(x: float) -> str:
@@ -273,12 +280,69 @@ def f32_literal(x: float) -> str:
     return text if "e" in text or "." in text else text + ".0"
 
 
+def scalar_literal(value, wgsl_type: str) -> str:
+    """``value`` as a WGSL literal of scalar type ``wgsl_type``: an f32 literal, or an integer with its ``u``/``i``
+    suffix (a value that is not an integer, or a negative u32, is refused)."""
+    if wgsl_type == "f32":
+        return f32_literal(value)
+    if wgsl_type not in SCALARS:
+        raise ValueError(f"{wgsl_type!r} is not a scalar type ({', '.join(SCALARS)})")
+    if isinstance(value, bool) or not float(value).is_integer() or (wgsl_type == "u32" and value < 0):
+        raise ValueError(f"{value!r} is not a {wgsl_type} value")
+    return f"{int(value)}{wgsl_type[0]}"
+
+
 def range_constants(params) -> list[str]:
-    """``const NAME_MIN: f32 = ...;`` and ``NAME_MAX`` for every non-boolean parameter (the registries' ``Param``:
-    ``name``, ``kind``, ``min``, ``max``), the bounds WGSL clamps a parameter to."""
+    """``const NAME_MIN: T = ...;`` and ``NAME_MAX`` in the parameter's own type T for every non-boolean parameter
+    (the registries' ``Param``: ``name``, ``kind``, ``min``, ``max``, ``wgsl_type``), the bounds WGSL clamps a
+    parameter to."""
     lines = []
     for p in params:
         if p.kind is not bool:
-            lines += [f"const {p.name.upper()}_MIN: f32 = {f32_literal(p.min)};",
-                      f"const {p.name.upper()}_MAX: f32 = {f32_literal(p.max)};"]
+            lines += [f"const {p.name.upper()}_MIN: {p.wgsl_type} = {scalar_literal(p.min, p.wgsl_type)};",
+                      f"const {p.name.upper()}_MAX: {p.wgsl_type} = {scalar_literal(p.max, p.wgsl_type)};"]
     return lines
+
+
+# Colour format name prefix -> its channels (WebGPU's renderable colour formats; depth formats have none).
+_FORMAT_CHANNELS = (("rgba", 4), ("bgra", 4), ("rgb10a2", 4), ("rg11b10", 3), ("rg", 2), ("r", 1))
+_OUTPUT_SCALARS = {"<f4": "f32", "<u4": "u32", "<i4": "i32"}
+
+
+class FragmentOutputs:
+    """A fragment entry point's output struct, generated from its render targets in order (location = position):
+    ``FragmentOutputs("Out", [("color", "vec4f", "rgba8unorm"), ("count", "u32", "r32uint")])`` declares
+    ``struct Out { @location(0) color: vec4f, @location(1) count: u32, }`` and its ``formats`` are the pipeline's
+    target formats, so what the shader writes and the textures it writes to come from one list. An output's type
+    must have its format's sample type (u32 for uint formats, i32 for sint, f32 for the others) and at least its
+    channels, as WebGPU asks of a pipeline: a mismatch is refused here, naming the output."""
+
+    def __init__(self, name: str, targets: Sequence[tuple[str, str, str]]):
+        if not targets:
+            raise ValueError(f"fragment outputs {name}: at least one target")
+        for field, wgsl_type, fmt in targets:
+            where = f"fragment outputs {name}: {field!r} ({wgsl_type}) to {fmt}"
+            channels = next((n for prefix, n in _FORMAT_CHANNELS if fmt.startswith(prefix)), None)
+            if channels is None:
+                raise ValueError(f"{where}: {fmt!r} is not a colour format")
+            if wgsl_type not in _BUILTINS or len(_BUILTINS[wgsl_type][3]) > 1:
+                raise ValueError(f"{where}: an output is a scalar or vector of f32, u32 or i32")
+            _, _, base, shape = _BUILTINS[wgsl_type]
+            scalar = "u32" if fmt.endswith("uint") else "i32" if fmt.endswith("sint") else "f32"
+            if _OUTPUT_SCALARS[base] != scalar or (shape[0] if shape else 1) < channels:
+                raise ValueError(f"{where}: the format needs {scalar} with at least {channels} components")
+        self.name = name
+        self.targets: tuple[tuple[str, str, str], ...] = tuple(targets)
+
+    @property
+    def formats(self) -> tuple[str, ...]:
+        return tuple(fmt for _, _, fmt in self.targets)
+
+    def wgsl(self) -> str:
+        lines = [f"struct {self.name} {{",
+                 *(f"    @location({i}) {field}: {t}," for i, (field, t, _) in enumerate(self.targets)), "}"]
+        return "\n".join(lines) + "\n"
+
+    def generated(self) -> Generated:
+        """``wgsl`` as a piece for ``core.wgsl.compose``."""
+        return Generated(f"<generated: struct {self.name}>", self.wgsl())

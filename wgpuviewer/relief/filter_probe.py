@@ -17,6 +17,7 @@ import wgpu
 from wgpuviewer.core.compute import Kernel, compute_for
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, get_gpu, mip_chain
+from wgpuviewer.core.structs import Struct
 
 from .filters import FILTER_GROUP, get_filter, pack_filter_params, resolve_filter_params, sampler_descriptor
 from .maps import binding
@@ -24,8 +25,12 @@ from .probe import FEWER, FIX, dispatch, io_layout_entries, material_bind_group,
 from .shaders import compose_technique
 from .techniques import get_technique, resolve_params
 
-SAMPLE_STRIDE = 48  # FilterSample: vec2f uv, dx, dy, pad, vec4f view
-OUT_STRIDE = 32  # FilterOut: vec4f value, u32 texels, depth_fetches, hidden, flags
+#: The filter probe's records (entry/filter_probe.wgsl binds an array of each and declares neither): a footprint
+#: in (view: V in tangent space, for visibility traces); the filtered value and the filter's statistics out.
+FILTER_SAMPLE = Struct("FilterSample", [("uv", "vec2f"), ("dx", "vec2f"), ("dy", "vec2f"), ("view", "vec3f")],
+                       "storage")
+FILTER_OUT = Struct("FilterOut", [("value", "vec4f"), ("texels", "u32"), ("depth_fetches", "u32"),
+                                  ("hidden", "u32"), ("flags", "u32")], "storage")
 TEXTURE_FORMAT = "rgba16float"  # as the renderer's albedo
 ENTRY = "filter_probe_main"
 
@@ -47,8 +52,9 @@ def _kernel(gpu: Gpu, technique_name: str, filter_name: str) -> Kernel:
     groups.append([{"binding": 0, "visibility": C, "buffer": {"type": wgpu.BufferBindingType.uniform}},
                    {"binding": 1, "visibility": C, "sampler": {"type": wgpu.SamplerBindingType.filtering}}])
     compute = compute_for(gpu)
-    return compute.kernel_of(compose_technique(technique, "filter_probe", filter_name),
-                             label=f"filter-probe:{technique_name}/{filter_name}", fix=FIX,
+    module = compose_technique(technique, "filter_probe", filter_name,
+                               records=(FILTER_SAMPLE.generated(), FILTER_OUT.generated()))
+    return compute.kernel_of(module, label=f"filter-probe:{technique_name}/{filter_name}", fix=FIX,
                              layout=compute.layout(groups, "filter-probe"))
 
 
@@ -102,10 +108,10 @@ def filter_probe(
     compute = compute_for(gpu)
     kernel = _kernel(gpu, tech.name, f.name)
     pipeline = kernel.pipeline(ENTRY)
-    samples = np.zeros((n, SAMPLE_STRIDE // 4), np.float32)
-    samples[:, 0:2], samples[:, 2:4], samples[:, 4:6], samples[:, 8:11] = uv, dx, dy, view
-    in_buf = compute.storage(samples, f"filter-probe:{n} samples", FEWER)
-    out_buf = compute.storage(n * OUT_STRIDE, f"filter-probe:out of {n} samples", FEWER)
+    samples = np.zeros(n, FILTER_SAMPLE.dtype)
+    samples["uv"], samples["dx"], samples["dy"], samples["view"] = uv, dx, dy, view
+    in_buf = compute.storage(FILTER_SAMPLE.pack_many(samples), f"filter-probe:{n} samples", FEWER)
+    out_buf = compute.storage(n * FILTER_OUT.size, f"filter-probe:out of {n} samples", FEWER)
     albedo = create_texture(gpu, mip_chain(np.asarray(texture, np.float32)), TEXTURE_FORMAT, "filter-probe:texture")
     material = material_bind_group(gpu, pipeline.get_bind_group_layout(1), tech, height, height_scale, tech_values,
                                    "repeat", extra=((binding("albedo"), albedo),))
@@ -114,7 +120,5 @@ def filter_probe(
     filter_group = compute.bind_group(pipeline.get_bind_group_layout(FILTER_GROUP), {0: params, 1: sampler},
                                       f"filter-probe:{f.name}")
     groups = [material, *[None] * (FILTER_GROUP - 2), filter_group]
-    raw = dispatch(kernel, ENTRY, groups, n, in_buf, out_buf, OUT_STRIDE)
-    u32 = raw.view(np.uint32)
-    return FilterProbeResult(value=raw.view(np.float32)[:, 0:4].copy(), texels=u32[:, 4].copy(),
-                             depth_fetches=u32[:, 5].copy(), hidden=u32[:, 6].copy(), flags=u32[:, 7].copy())
+    out = dispatch(kernel, ENTRY, groups, n, in_buf, out_buf, FILTER_OUT)
+    return FilterProbeResult(**{name: out[name].copy() for name in FILTER_OUT.names})  # FilterOut's fields, by name

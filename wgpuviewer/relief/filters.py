@@ -5,10 +5,10 @@ A filter decides how the albedo and the normal map are read at the traced hit (`
 footprint that drops the texels the relief hides (``ewa_vis``, after Romanyuk & Dudnyk 2017, filtering with parallax
 mapping). A derivative source decides which footprint the filter is given: the derivatives of the unperturbed
 surface uv (the default), of the traced hit uv, or the hit's local Jacobian. Everything WGSL must agree on is
-generated from these entries (``filter_interface``): the ``FilterParams`` uniform (the filter's parameters, padded),
-``NAME_MIN`` / ``NAME_MAX`` constants for them, the stat flags, the visibility tolerance and the derivative bound.
-The renderer makes the filter's sampler from ``Filter.sampler`` (WebGPU allows anisotropy only with linear min, mag
-and mipmap filters).
+generated from these entries (``filter_interface``): the ``FilterParams`` uniform (the filter's parameters, each of
+its own WGSL type, padded), ``NAME_MIN`` / ``NAME_MAX`` constants for them in that type, the stat flags, the
+visibility tolerance and the derivative bound. The renderer makes the filter's sampler from ``Filter.sampler``
+(WebGPU allows anisotropy only with linear min, mag and mipmap filters).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.structs import Struct, f32_literal, f32_uniform, range_constants
+from wgpuviewer.core.structs import Struct, f32_literal, range_constants, scalar_uniform
 from wgpuviewer.core.wgsl import Generated
 
 from .techniques import Param, Parametrized, resolve_params
@@ -68,9 +68,9 @@ class Filter(Parametrized):
         return f"filters/{self.name}.wgsl"
 
     @property
-    def uniform_fields(self) -> tuple[str, ...]:
-        """FilterParams fields in order (all f32), without padding."""
-        return tuple(p.name for p in self.params)
+    def uniform_fields(self) -> tuple[tuple[str, str], ...]:
+        """(name, WGSL type) of the FilterParams fields in order (``Param.wgsl_type``), without padding."""
+        return tuple((p.name, p.wgsl_type) for p in self.params)
 
 
 @dataclass(frozen=True)
@@ -164,9 +164,9 @@ def resolve_filter_params(f: Filter, overrides: dict | None = None, where: str =
 
 
 def filter_params(f: Filter) -> Struct:
-    """The filter's FilterParams uniform: its parameters in order, padded to 16 bytes (all f32; the filter WGSL
-    converts counts where it uses them)."""
-    return f32_uniform("FilterParams", f.uniform_fields)
+    """The filter's FilterParams uniform: its parameters in order (counts u32, real numbers f32), padded to 16
+    bytes."""
+    return scalar_uniform("FilterParams", f.uniform_fields)
 
 
 def filter_uniform_size(f: Filter) -> int:
@@ -187,9 +187,9 @@ def filter_interface(f: Filter) -> Generated:
 
 
 def pack_filter_params(f: Filter, params: dict) -> bytes:
-    """FilterParams uniform data (missing values take the defaults)."""
+    """FilterParams uniform data, each value in its field's type (missing values take the defaults)."""
     values = {**f.defaults(), **params}
-    return filter_params(f).pack({name: float(values[name]) for name in f.uniform_fields})
+    return filter_params(f).pack({p.name: values[p.name] for p in f.params})
 
 
 def sampler_descriptor(f: Filter, params: dict) -> dict:

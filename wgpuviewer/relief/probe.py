@@ -22,13 +22,16 @@ from maptools import validate_height
 from wgpuviewer.core.compute import Kernel, compute_for
 from wgpuviewer.core.errors import InputError
 from wgpuviewer.core.gpu import Gpu, get_gpu
+from wgpuviewer.core.structs import Struct
 
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
 from .shaders import compose_technique, pack_trace_params
 from .techniques import TECHNIQUES, get_technique, resolve_params
 
-RAY_STRIDE = 32  # ProbeRay: vec2f uv, vec2f pad, vec4f view
-HIT_STRIDE = 32  # ProbeHit: vec2f uv, f32 depth, u32 fetches, u32 capped, u32 layers, vec2u pad
+#: The probe's records (entry/probe.wgsl binds an array of each and declares neither): a ray in, its hit out.
+PROBE_RAY = Struct("ProbeRay", [("uv", "vec2f"), ("view", "vec3f")], "storage")  # view: V in tangent space
+PROBE_HIT = Struct("ProbeHit", [("uv", "vec2f"), ("depth", "f32"), ("fetches", "u32"), ("capped", "u32"),
+                                ("layers", "u32")], "storage")
 WORKGROUP = 64  # @workgroup_size of the probe entry points
 _MAX_GROUPS = 65535  # workgroups along x of a large set (common/probe_index.wgsl folds the 2D grid at this width)
 ENTRY = "probe_main"
@@ -70,8 +73,8 @@ def _kernel(gpu: Gpu, technique_name: str) -> Kernel:
     C = wgpu.ShaderStage.COMPUTE
     compute = compute_for(gpu)
     layout = compute.layout([io_layout_entries(C), material_layout_entries(technique)], "probe")
-    return compute.kernel_of(compose_technique(technique, "probe"), label=f"probe:{technique.name}", fix=FIX,
-                             layout=layout)
+    module = compose_technique(technique, "probe", records=(PROBE_RAY.generated(), PROBE_HIT.generated()))
+    return compute.kernel_of(module, label=f"probe:{technique.name}", fix=FIX, layout=layout)
 
 
 def probe(
@@ -155,18 +158,15 @@ def _trace(tech, values: dict, height: np.ndarray, uv: np.ndarray, view: np.ndar
     gpu = get_gpu(backend, quiet=True)
     compute = compute_for(gpu)
     kernel = _kernel(gpu, tech.name)
-    rays = np.zeros((n, RAY_STRIDE // 4), np.float32)
-    rays[:, 0:2] = uv
-    rays[:, 4:7] = view
-    ray_buf = compute.storage(rays, f"probe:{n} rays", FEWER)
-    hit_buf = compute.storage(n * HIT_STRIDE, f"probe:hits of {n} rays", FEWER)
+    rays = np.zeros(n, PROBE_RAY.dtype)
+    rays["uv"], rays["view"] = uv, view
+    ray_buf = compute.storage(PROBE_RAY.pack_many(rays), f"probe:{n} rays", FEWER)
+    hit_buf = compute.storage(n * PROBE_HIT.size, f"probe:hits of {n} rays", FEWER)
     layout = kernel.pipeline(ENTRY).get_bind_group_layout(1)
     material_group = material_bind_group(gpu, layout, tech, height, height_scale, values, address)
-    raw = dispatch(kernel, ENTRY, [material_group], n, ray_buf, hit_buf, HIT_STRIDE)
-    f32 = raw.view(np.float32)
-    u32 = raw.view(np.uint32)
-    return ProbeResult(uv=f32[:, 0:2].astype(np.float64), depth=f32[:, 2].copy(), fetches=u32[:, 3].copy(),
-                       capped=u32[:, 4] != 0, layers=u32[:, 5].copy())
+    hits = dispatch(kernel, ENTRY, [material_group], n, ray_buf, hit_buf, PROBE_HIT)
+    return ProbeResult(uv=hits["uv"].astype(np.float64), depth=hits["depth"].copy(), fetches=hits["fetches"].copy(),
+                       capped=hits["capped"] != 0, layers=hits["layers"].copy())
 
 
 def io_layout_entries(visibility) -> list[dict]:
@@ -201,9 +201,9 @@ def material_bind_group(gpu: Gpu, layout, tech, height: np.ndarray, height_scale
 
 
 def dispatch(kernel: Kernel, entry: str, groups: list, n: int, inputs: wgpu.GPUBuffer, outputs: wgpu.GPUBuffer,
-             stride: int) -> np.ndarray:
+             output: Struct) -> np.ndarray:
     """Run a probe kernel over ``n`` items: group 0 binds ``inputs`` and ``outputs``, then ``groups`` (index - 1 =
-    group; None: skip); read ``outputs`` back as (n, stride) bytes."""
+    group; None: skip); read ``outputs`` back as ``n`` records of ``output`` (a structured array of its dtype)."""
     compute = kernel.compute
     count = -(-n // WORKGROUP)
     encoder = compute.encoder("probe")
@@ -211,4 +211,4 @@ def dispatch(kernel: Kernel, entry: str, groups: list, n: int, inputs: wgpu.GPUB
     threads = (WORKGROUP * min(count, _MAX_GROUPS), -(-count // _MAX_GROUPS))
     kernel.dispatch(encoder, entry, {0: inputs, 1: outputs}, threads, size=(WORKGROUP,), groups=groups)
     compute.submit(encoder)
-    return compute.read(outputs, n * stride, np.uint8).reshape(n, stride)
+    return output.unpack(compute.read(outputs, n * output.size, np.uint8), n)

@@ -24,6 +24,7 @@ from wgpuviewer import camera as cam
 from wgpuviewer import meshes, textures
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
+from wgpuviewer.core.structs import FragmentOutputs
 from wgpuviewer.scene import Camera, Scene
 
 from . import autotable
@@ -47,8 +48,16 @@ DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, d
 LAYERS_FORMAT = "r32uint"  # offscreen: depth layers the search used per pixel
 FILTER_FORMAT = "rgba32uint"  # offscreen: the filter's texels, depth fetches, hidden | flags << 24, ratio bits
 DEPTH_FORMAT = "depth32float"
-#: The targets of an offscreen render (fs_data), in order.
-OFFSCREEN_FORMATS = (COLOR_FORMAT, DATA_FORMAT, LAYERS_FORMAT, FILTER_FORMAT)
+#: The targets of an offscreen render, in order: fs_data's outputs (generated into the render module) and their
+#: formats. Raw values travel as float bits in 32-bit integer targets: float32 targets are not renderable
+#: everywhere (OpenGL ES), 32-bit integer ones are.
+DATA_OUT = FragmentOutputs("DataOut", [
+    ("color", "vec4f", COLOR_FORMAT),
+    ("data", "vec4u", DATA_FORMAT),  # fetches negative: capped
+    ("layers", "u32", LAYERS_FORMAT),
+    ("filtering", "vec4u", FILTER_FORMAT),
+])
+OFFSCREEN_FORMATS = DATA_OUT.formats
 
 #: Frame.mode values (render.wgsl).
 MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4, "albedo": 5}
@@ -314,7 +323,7 @@ class Renderer:
 
     def module(self, technique: Technique, filter: str = DEFAULT_FILTER, derivatives: str = DEFAULT_DERIVATIVES):
         """The composed render module (``core.wgsl.Module``) of a technique with a filter and derivative source."""
-        return compose_technique(technique, "render", filter, derivatives)
+        return compose_technique(technique, "render", filter, derivatives, records=(DATA_OUT.generated(),))
 
     def pipeline(self, technique: Technique, formats: tuple[str, ...], filter: str = DEFAULT_FILTER,
                  derivatives: str = DEFAULT_DERIVATIVES) -> wgpu.GPURenderPipeline:

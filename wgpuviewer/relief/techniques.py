@@ -3,8 +3,9 @@
 An entry names what a technique needs (textures and maps, by their slot names in ``maps.MAP_SLOTS``), its
 parameters with defaults and ranges, and whether it is a ray search (then its WGSL defines ``trace`` and the
 probe can run it). Everything WGSL must agree on is generated from the entry (``shaders.interface``): the
-``TraceParams`` uniform (the common fields, then the parameters, then the fixed values), one binding line per
-texture it needs, and ``NAME_MIN`` / ``NAME_MAX`` constants for its numeric parameters.
+``TraceParams`` uniform (the common fields, then the parameters, then the fixed values, each of its own WGSL type:
+f32, u32 or i32), one binding line per texture it needs, and ``NAME_MIN`` / ``NAME_MAX`` constants for its numeric
+parameters, in the parameter's type.
 """
 
 from __future__ import annotations
@@ -15,11 +16,11 @@ from dataclasses import dataclass
 
 from wgpuviewer.core.errors import UserError
 
-#: The first fields of every technique's ``TraceParams`` uniform (f32): the material's relief depth and the
-#: depth map's size in texels (for the mip level). The technique's parameters and fixed values follow.
-#: TraceParams fields every technique has: the material's relief scale, its depth map's size and depth range
-#: (maps.depth_range: the layer searches march only that range, common/trace.wgsl's relief_range).
-COMMON_TRACE_FIELDS = ("height_scale", "depth_width", "depth_height", "depth_min", "depth_max")
+#: TraceParams fields every technique has, with their WGSL types: the material's relief scale, its depth map's size
+#: in texels (for the mip level) and depth range (maps.depth_range: the layer searches march only that range,
+#: common/trace.wgsl's relief_range). The technique's parameters and fixed values follow.
+COMMON_TRACE_FIELDS = (("height_scale", "f32"), ("depth_width", "u32"), ("depth_height", "u32"), ("depth_min", "f32"),
+                       ("depth_max", "f32"))
 
 #: Full heat of the cost view for techniques without a layer bound (fetches per pixel).
 COMMON_COST_SCALE = 64.0
@@ -65,6 +66,35 @@ class Param:
             raise UserError(f"{where} = {value!r}: out of range, expected {self.min:g} to {self.max:g}")
         return self.kind(value)
 
+    @property
+    def wgsl_type(self) -> str:
+        """Its type in the generated uniform and its NAME_MIN / NAME_MAX constants: f32 for a number, u32 for a flag
+        (0 or 1) and for an integer whose range starts at 0 or above, i32 for one whose range goes below 0."""
+        if self.kind is float:
+            return "f32"
+        return "i32" if self.kind is int and self.min < 0 else "u32"
+
+
+#: The WGSL types a fixed TraceParams value may have: a count, a signed integer, a real number.
+FIXED_TYPES = ("u32", "i32", "f32")
+
+
+@dataclass(frozen=True)
+class Fixed:
+    """A TraceParams value fixed by the technique (not a user parameter), e.g. a property of the map it samples,
+    with its WGSL type: ``u32`` (a count), ``i32`` (a signed integer) or ``f32`` (a real number)."""
+
+    name: str
+    value: int | float
+    wgsl_type: str
+
+    def __post_init__(self):
+        if self.wgsl_type not in FIXED_TYPES:
+            raise ValueError(f"fixed value {self.name!r}: type {self.wgsl_type!r} is not one of {', '.join(FIXED_TYPES)}")
+        integer = isinstance(self.value, int) and not isinstance(self.value, bool)
+        if self.wgsl_type != "f32" and not (integer and (self.wgsl_type == "i32" or self.value >= 0)):
+            raise ValueError(f"fixed value {self.name!r} = {self.value!r} is not a {self.wgsl_type}")
+
 
 class Parametrized:
     """A registry entry with ``params`` (a tuple of Param): lookup by name and the default values."""
@@ -91,7 +121,7 @@ class Technique(Parametrized):
     #: The WGSL file: a name in wgsl/techniques/ (default NAME.wgsl) or an absolute path.
     wgsl: str = ""
     #: TraceParams values fixed by the technique (not user parameters), e.g. a property of the map it samples.
-    fixed: tuple[tuple[str, float], ...] = ()
+    fixed: tuple[Fixed, ...] = ()
     #: Ray searches: the most fetches one ray may count, given the parameters (the contract tests hold every
     #: ray-search technique to it).
     fetch_bound: Callable[[dict], int] | None = None
@@ -118,9 +148,20 @@ class Technique(Parametrized):
         return name if name.startswith("/") else f"techniques/{name}"
 
     @property
+    def trace_field_types(self) -> tuple[tuple[str, str], ...]:
+        """(name, WGSL type) of this technique's TraceParams fields, in order: the common ones, the parameters
+        (``Param.wgsl_type``), the fixed values (``Fixed.wgsl_type``)."""
+        return (COMMON_TRACE_FIELDS + tuple((p.name, p.wgsl_type) for p in self.params)
+                + tuple((f.name, f.wgsl_type) for f in self.fixed))
+
+    @property
     def trace_fields(self) -> tuple[str, ...]:
-        """Fields of this technique's TraceParams uniform, in order (all f32)."""
-        return COMMON_TRACE_FIELDS + tuple(p.name for p in self.params) + tuple(name for name, _ in self.fixed)
+        """Names of this technique's TraceParams fields, in order."""
+        return tuple(name for name, _ in self.trace_field_types)
+
+    def fixed_values(self) -> dict:
+        """The fixed TraceParams values by name."""
+        return {f.name: f.value for f in self.fixed}
 
     @property
     def needs_depth(self) -> bool:
@@ -192,13 +233,15 @@ def _layer_search(name: str, key: str, description: str, accuracy_settings: tupl
     )
 
 
-def distance_fixed(sectors: int, bands: int, max_angle: float | None) -> tuple[tuple[str, float], ...]:
+def distance_fixed(sectors: int, bands: int, max_angle: float | None) -> tuple[Fixed, ...]:
     """TraceParams values of distance.wgsl for a texture of ``sectors`` x ``bands`` direction volumes plus the plain
-    one (max_angle = None: the plain map alone, one volume every ray reads)."""
+    one (max_angle = None: the plain map alone, one volume every ray reads; steep_cos -2: no ray is steeper)."""
     if max_angle is None:
-        return (("sectors", 1.0), ("bands", 1.0), ("steep_cos", -2.0), ("volumes", 1.0))
-    return (("sectors", float(sectors)), ("bands", float(bands)), ("steep_cos", math.cos(math.radians(max_angle))),
-            ("volumes", float(sectors * bands + 1)))
+        sectors, bands, steep_cos, volumes = 1, 1, -2.0, 1
+    else:
+        steep_cos, volumes = math.cos(math.radians(max_angle)), sectors * bands + 1
+    return (Fixed("sectors", sectors, "u32"), Fixed("bands", bands, "u32"), Fixed("steep_cos", steep_cos, "f32"),
+            Fixed("volumes", volumes, "u32"))
 
 
 TECHNIQUES: dict[str, Technique] = {
@@ -331,7 +374,7 @@ TECHNIQUES: dict[str, Technique] = {
                 Param("skip_steps", 8, 1, 64, int, "quadmax steps before the POM finish"),
                 Param("layers", 16, 1, MAX_LAYERS, int, "POM layers over the rest of the ray"),
             ),
-            ray_search=True, fixed=(("top_offset", float(QUADMAX_TOP_OFFSET)),),
+            ray_search=True, fixed=(Fixed("top_offset", QUADMAX_TOP_OFFSET, "i32"),),
             fetch_bound=lambda p: 2 * p["skip_steps"] + p["layers"] + 1,
             cost_view_scale=lambda p: p["layers"] + 1.0, layers_view_range=lambda p: (0.0, float(p["layers"])),
             contract_params=({"skip_steps": 1, "layers": 1},), accuracy_settings=({}, {"skip_steps": 16}),
@@ -347,8 +390,8 @@ TECHNIQUES: dict[str, Technique] = {
                    float, "UV error budget in texels (the table's budgets are powers of 2: the largest one not "
                    "above this is used)"),),
             ray_search=True,
-            fixed=(("bin_tan0", AUTO_TAN0), ("bins_per_octave", float(AUTO_BINS_PER_OCTAVE)),
-                   ("budget_log2_min", float(AUTO_BUDGET_LOG2_MIN)), ("quadmax_steps", float(QUADMAX_STEPS))),
+            fixed=(Fixed("bin_tan0", AUTO_TAN0, "f32"), Fixed("bins_per_octave", AUTO_BINS_PER_OCTAVE, "u32"),
+                   Fixed("budget_log2_min", AUTO_BUDGET_LOG2_MIN, "i32"), Fixed("quadmax_steps", QUADMAX_STEPS, "u32")),
             fetch_bound=lambda p: max(TECHNIQUES[name].fetch_bound(resolve_params(TECHNIQUES[name], params))
                                       for name, params in AUTO_CANDIDATES if TECHNIQUES[name].ray_search),
             cost_view_scale=common_cost_scale,
@@ -371,8 +414,8 @@ TECHNIQUES: dict[str, Technique] = {
             ("albedo", "normal", "depth", "cone"),
             (Param("iterations", 128, 1, 4096, int, "cap on steps (cell solves + cone skips); capped rays flagged"),),
             ray_search=True, exact=True,
-            fixed=(("max_ratio", CONE_MAX_RATIO), ("halvings_max", float(CONE_HALVINGS_MAX)),
-                   ("finish_cells", float(CONE_FINISH_CELLS))),
+            fixed=(Fixed("max_ratio", CONE_MAX_RATIO, "f32"), Fixed("halvings_max", CONE_HALVINGS_MAX, "u32"),
+                   Fixed("finish_cells", CONE_FINISH_CELLS, "u32")),
             fetch_bound=lambda p: 2 * p["iterations"] + CONE_HALVINGS_MAX + CONE_FINISH_CELLS,
             cost_view_scale=common_cost_scale, layers_view_range=no_layers,
             contract_params=({"iterations": 8},), accuracy_settings=({},),

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import wgpu
 
+from wgpuviewer.core.structs import Struct
 from wgpuviewer.core.wgsl import compose
 from wgpuviewer.relief.reference import uv_error_texels
 from wgpuviewer.relief.renderer import DrawConfig, Renderer
@@ -19,6 +20,12 @@ from wgpuviewer.relief.renderer import DrawConfig, Renderer
 REFERENCE = "pom"
 REFERENCE_LAYERS = 512
 MAX_WIDTH = 400  # error maps are computed at most this wide (offscreen renders + a CPU readback)
+#: The overlay's uniform (entry/error_view.wgsl uses it and does not declare it).
+BLIT = Struct("Blit", [
+    ("rect", "vec4f"),  # x, y, w, h of the viewport part in pixels (the scissor)
+    ("max_value", "f32"),  # value shown as full heat
+])
+
 
 def map_size(window: tuple[int, int]) -> tuple[int, int]:
     w, h = window
@@ -57,7 +64,8 @@ class ErrorOverlay:
 
     def __init__(self, device: wgpu.GPUDevice, target_format: str):
         self.device = device
-        module = device.create_shader_module(label="error-view", code=compose("entry/error_view.wgsl").code)
+        code = compose(BLIT.generated(), "entry/error_view.wgsl").code
+        module = device.create_shader_module(label="error-view", code=code)
         F = wgpu.ShaderStage.FRAGMENT
         self.layout = device.create_bind_group_layout(
             label="error-view",
@@ -76,7 +84,7 @@ class ErrorOverlay:
         self.texture = None
         self.group = None
         self.uniform = device.create_buffer(
-            label="error-view", size=32, usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST
+            label="error-view", size=BLIT.size, usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST
         )
 
     def upload(self, values: np.ndarray) -> None:
@@ -102,9 +110,7 @@ class ErrorOverlay:
         """Paint over ``rect`` (x, y, w, h in target pixels) of ``view``; the texture spans the rect."""
         if self.group is None:
             return
-        self.device.queue.write_buffer(
-            self.uniform, 0, np.array([*rect, max(max_value, 1e-6), 0, 0, 0], np.float32).tobytes()
-        )
+        self.device.queue.write_buffer(self.uniform, 0, BLIT.pack({"rect": rect, "max_value": max(max_value, 1e-6)}))
         rpass = encoder.begin_render_pass(
             label="error-view",
             color_attachments=[{"view": view, "load_op": "load", "store_op": "store"}],

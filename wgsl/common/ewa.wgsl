@@ -153,7 +153,7 @@ fn ewa(tex: texture_2d<f32>, footprint: Footprint, visibility: bool, rows: bool)
     let lod = clamp(log2(max(axes.minor, 1e-8)) - 1.0, 0.0, f32(top));
     var level = i32(floor(lod));
     var frac = lod - f32(level);
-    let budget = u32(clamp(filter_params.max_texels, MAX_TEXELS_MIN, MAX_TEXELS_MAX));
+    let budget = clamp(filter_params.max_texels, MAX_TEXELS_MIN, MAX_TEXELS_MAX);
     var acc = EwaSum(vec4f(0.0), 0.0, 0u, 0u, budget);
     for (var k = 0; k < 32 && level < top; k++) {
         var estimate = ewa_estimate(ewa_level(tex, fp, level));

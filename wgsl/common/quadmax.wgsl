@@ -95,11 +95,11 @@ struct QuadmaxWalk {
     found: bool,
 }
 
-fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> TraceResult {
+fn quadmax_search(uv0: vec2f, v: vec3f, top_offset: i32, max_steps: u32) -> TraceResult {
     return quadmax_walk(uv0, v, top_offset, max_steps).result;
 }
 
-fn quadmax_walk(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> QuadmaxWalk {
+fn quadmax_walk(uv0: vec2f, v: vec3f, top_offset: i32, max_steps: u32) -> QuadmaxWalk {
     let wh = vec2i(textureDimensions(depth_tex, 0));
     // The root: the first level (>= 1) of one node (sizes ceil-halve: level m has ceil(W / 2^m) columns).
     let root = max(1u, 32u - countLeadingZeros(u32(max(wh.x, wh.y) - 1)));
@@ -107,7 +107,7 @@ fn quadmax_walk(uv0: vec2f, v: vec3f, top_offset: f32, max_steps: u32) -> Quadma
     let size = vec2f(wh);
     let start = uv0 * size - 0.5;
     let dir = -span * size;  // texel coordinates per unit t
-    let top = u32(clamp(floor(log2(max(length(dir), 1.0))) + top_offset, 1.0, f32(root)));
+    let top = u32(clamp(floor(log2(max(length(dir), 1.0))) + f32(top_offset), 1.0, f32(root)));
     // The quad texels read last, one for the even and one for the odd levels (the walk tests a node with its
     // parent's texel and moves between neighbouring levels: two slots keep nearly every reuse).
     // (tagged with the level: nodes of two levels may have the same coordinates).

@@ -1,14 +1,8 @@
 // The viewer's error view (wgpuviewer/viewer/error_view.py): an r32float texture of per-pixel values painted
 // over part of the frame with the cost view's heat ramp; negative values keep the frame underneath.
+// Blit is generated from wgpuviewer/viewer/error_view.py (BLIT).
 // #include "common/heat.wgsl"
 
-struct Blit {
-    rect: vec4f,      // x, y, w, h of the viewport part in pixels (scissor)
-    max_value: f32,   // value shown as full heat
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
-}
 @group(0) @binding(0) var<uniform> blit: Blit;
 @group(0) @binding(1) var values: texture_2d<f32>;
 

@@ -59,7 +59,7 @@ fn shade(in: VertexOut) -> Shaded {
     // they do not jump where the traced UV does (silhouettes, tiling seams).
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
-    let texels = vec2f(trace_params.depth_width, trace_params.depth_height);
+    let texels = vec2f(f32(trace_params.depth_width), f32(trace_params.depth_height));
     let footprint = max(dot(duv_dx * texels, duv_dx * texels), dot(duv_dy * texels, duv_dy * texels));
     let lod = max(0.5 * log2(max(footprint, 1e-12)), 0.0);
 
@@ -123,18 +123,11 @@ fn fs_color(in: VertexOut) -> @location(0) vec4f {
     }
 }
 
-struct DataOut {
-    @location(0) color: vec4f,
-    // hit u, hit v, hit depth, fetches (negative: capped), as float bits: float32 targets are not
-    // renderable everywhere (OpenGL ES), 32-bit integer targets are.
-    @location(1) data: vec4u,
-    @location(2) layers: u32,  // depth layers the search used (MODE_LAYERS / the `layers` output mode)
-    // texels the filter read, depth fetches of its visibility traces and slopes, hidden texels | flags << 24,
-    // the derivative source's raw length ratio as float bits (FilterStats, common/footprint.wgsl)
-    @location(3) filtering: vec4u,
-}
-
-// Offscreen output: the shaded colour plus the raw trace data (uv/depth/cost modes, .npy files).
+// Offscreen output: the shaded colour plus the raw trace data (uv/depth/cost modes, .npy files). DataOut is
+// generated from the renderer's offscreen targets (wgpuviewer/relief/renderer.py, DATA_OUT): color; data: hit u,
+// hit v, hit depth, fetches (negative: capped) as float bits; layers: depth layers the search used; filtering:
+// texels the filter read, depth fetches of its visibility traces and slopes, hidden texels | flags << 24, the
+// derivative source's raw length ratio as float bits (FilterStats, common/footprint.wgsl).
 @fragment
 fn fs_data(in: VertexOut) -> DataOut {
     let s = shade(in);

@@ -8,7 +8,7 @@ fn filter_texture(tex: texture_2d<f32>, fp: Footprint) -> vec4f {
     let f = sanitized(fp);
     let size = vec2f(textureDimensions(tex, 0));
     let axes = footprint_axes(texture_bounded(f.dx, size) * size, texture_bounded(f.dy, size) * size);
-    let most = clamp(filter_params.max_anisotropy, MAX_ANISOTROPY_MIN, MAX_ANISOTROPY_MAX);
+    let most = f32(clamp(filter_params.max_anisotropy, MAX_ANISOTROPY_MIN, MAX_ANISOTROPY_MAX));
     let probes = clamp(ceil(axes.major / max(axes.minor, 1e-8)), 1.0, most);
     filter_stats.texels += 8u * u32(probes);
     return textureSampleGrad(tex, filter_sampler, f.uv, f.dx, f.dy);

@@ -32,12 +32,12 @@ fn auto_pick(v: vec3f) -> AutoPick {
         if tan_view < trace_params.bin_tan0 {
             bin = 0;
         } else {
-            let b = floor(trace_params.bins_per_octave * log2(tan_view / trace_params.bin_tan0)) + 1.0;
+            let b = floor(f32(trace_params.bins_per_octave) * log2(tan_view / trace_params.bin_tan0)) + 1.0;
             bin = i32(clamp(b, 0.0, f32(dims.x - 1)));
         }
     }
     let budget = clamp(trace_params.max_error, MAX_ERROR_MIN, MAX_ERROR_MAX);
-    let level = i32(clamp(floor(log2(budget)) - trace_params.budget_log2_min, 0.0, f32(dims.y - 1)));
+    let level = i32(clamp(floor(log2(budget)) - f32(trace_params.budget_log2_min), 0.0, f32(dims.y - 1)));
     return AutoPick(textureLoad(auto_table_tex, vec2i(bin, level), 0), bin, dims.x, tan_view);
 }
 
@@ -50,7 +50,7 @@ fn auto_pom_layers(pick: AutoPick) -> u32 {
     if pick.bin < 1 || pick.bin >= pick.bins - 1 {
         return u32(n);
     }
-    let tan_hi = trace_params.bin_tan0 * exp2(f32(pick.bin) / trace_params.bins_per_octave);
+    let tan_hi = trace_params.bin_tan0 * exp2(f32(pick.bin) / f32(trace_params.bins_per_octave));
     return u32(clamp(ceil(n * pick.tan_view / tan_hi), 1.0, n));
 }
 
@@ -70,7 +70,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
             r = pom_search(uv0, v, lod, 0.0, auto_pom_layers(pick));
         }
         default: {
-            r = quadmax_search(uv0, v, choice.z, u32(trace_params.quadmax_steps));
+            r = quadmax_search(uv0, v, i32(choice.z), trace_params.quadmax_steps);
         }
     }
     r.capped = r.capped || is_grazing(v);

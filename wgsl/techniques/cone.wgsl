@@ -51,7 +51,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     let dir = -span * vec2f(wh);            // cell coordinates per unit t
     let k = length(span) * f32(wh.x);       // texels of u per unit t (the cone map's metric)
     let widest = trace_params.max_ratio;    // the map's largest stored ratio
-    let cap = u32(clamp(trace_params.iterations, 1.0, ITERATIONS_MAX));
+    let cap = clamp(trace_params.iterations, ITERATIONS_MIN, ITERATIONS_MAX);
     var t = 0.0;
     var t_free = 0.0;   // the ray is free on [0, t_free]
     var cell = vec2i(floor(start));
@@ -114,7 +114,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     var lo = t_free;
     var hi = t;
     let cells_per_t = max(abs(dir.x), abs(dir.y));
-    for (var h = 0u; h < u32(trace_params.halvings_max) && (hi - lo) * cells_per_t > 1.0; h++) {
+    for (var h = 0u; h < trace_params.halvings_max && (hi - lo) * cells_per_t > 1.0; h++) {
         let mid = 0.5 * (lo + hi);
         let p = start + mid * dir;
         let mc = vec2i(floor(p));
@@ -126,7 +126,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     }
     t = lo;
     cell = vec2i(floor(start + lo * dir));
-    for (var s = 0u; s < u32(trace_params.finish_cells); s++) {
+    for (var s = 0u; s < trace_params.finish_cells; s++) {
         let n = walk_node(cell, 0u, wh, start, dir);
         if n.t_exit > t || t >= 1.0 {  // else lo rounded into a cell the ray has already left: no solve there
             let hit = cell_root(cell_corners(cell), cell, start, dir, t, min(n.t_exit, hi));

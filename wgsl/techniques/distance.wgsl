@@ -49,7 +49,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     let start = uv0 * size - 0.5;
     let dir = -span * size;
     let per_t = size.x * length(vec3f(span, trace_params.height_scale));
-    let cap = u32(clamp(trace_params.iterations, 1.0, ITERATIONS_MAX));
+    let cap = clamp(trace_params.iterations, ITERATIONS_MIN, ITERATIONS_MAX);
     var t = 0.0;
     for (var step = 0u; step < cap; step++) {
         let texel = vec2i(floor((uv0 - span * t) * size));

@@ -40,7 +40,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     var cell = vec2i(floor(start));
     var t = 0.0;
     var level = top;
-    let cap = u32(clamp(trace_params.max_steps, 1.0, MAX_STEPS_MAX));
+    let cap = clamp(trace_params.max_steps, MAX_STEPS_MIN, MAX_STEPS_MAX);
     for (var step = 0u; step < cap; step++) {
         let n = walk_node(cell, level, wh, start, dir);
         if level > 0u {

@@ -3,5 +3,5 @@
 
 fn trace(uv: vec2f, v: vec3f, lod: f32) -> TraceResult {
     fetch_count = 0u;
-    return parallax_offset(uv, v, lod, trace_params.offset_limiting > 0.5);
+    return parallax_offset(uv, v, lod, trace_params.offset_limiting != 0u);
 }

@@ -5,5 +5,5 @@
 
 fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     fetch_count = 0u;
-    return pom_search(uv0, v, lod, 0.0, u32(clamp(trace_params.layers, 1.0, LAYERS_MAX)));
+    return pom_search(uv0, v, lod, 0.0, clamp(trace_params.layers, LAYERS_MIN, LAYERS_MAX));
 }

@@ -8,11 +8,11 @@
 // #include "common/layer_march.wgsl"
 
 fn adaptive_layer_count(uv0: vec2f, v: vec3f) -> u32 {
-    let nmin = trace_params.min_layers;
-    let nmax = trace_params.max_layers;
+    let nmin = f32(trace_params.min_layers);  // the counts mix as real numbers; N is truncated at the end
+    let nmax = f32(trace_params.max_layers);
     let cos_view = min(abs(v.z) / max(length(v), 1e-30), 1.0);  // |V.N| for a unit V
     var n: f32;
-    if trace_params.angle_only > 0.5 {
+    if trace_params.angle_only != 0u {
         n = mix(nmax, nmin, cos_view);
     } else {
         let g = 1.0 - cos_view;

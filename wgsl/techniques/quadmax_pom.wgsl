@@ -12,9 +12,10 @@
 
 fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     fetch_count = 0u;
-    let skip = quadmax_walk(uv0, v, trace_params.top_offset, u32(clamp(trace_params.skip_steps, 1.0, SKIP_STEPS_MAX)));
+    let steps = clamp(trace_params.skip_steps, SKIP_STEPS_MIN, SKIP_STEPS_MAX);
+    let skip = quadmax_walk(uv0, v, trace_params.top_offset, steps);
     if skip.found {
         return skip.result;  // (flagged capped at grazing views, like quadmax's own hits)
     }
-    return pom_search(uv0, v, lod, skip.result.depth, u32(clamp(trace_params.layers, 1.0, LAYERS_MAX)));
+    return pom_search(uv0, v, lod, skip.result.depth, clamp(trace_params.layers, LAYERS_MIN, LAYERS_MAX));
 }

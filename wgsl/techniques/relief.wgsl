@@ -7,7 +7,7 @@
 
 fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     fetch_count = 0u;
-    let n = u32(clamp(trace_params.linear_steps, 1.0, LINEAR_STEPS_MAX));
+    let n = clamp(trace_params.linear_steps, LINEAR_STEPS_MIN, LINEAR_STEPS_MAX);
     let range = relief_range(0.0);  // the map's depth range: no step outside it can meet the surface
     let step = (range.y - range.x) / f32(n);
     let span = parallax_span(v);
@@ -21,7 +21,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
         return TraceResult(uv0 - span * range.x, range.x, fetch_count, is_grazing(v), n);
     }
     // The bracket: the last step above the surface, the first one below (or on) it.
-    let nb = u32(clamp(trace_params.binary_steps, 0.0, BINARY_STEPS_MAX));
+    let nb = clamp(trace_params.binary_steps, BINARY_STEPS_MIN, BINARY_STEPS_MAX);
     let below = range.x + f32(i) * step;
     let hi = binary_refine(uv0, span, below - step, below, nb, lod).y;
     return TraceResult(uv0 - span * hi, hi, fetch_count, is_grazing(v), n);

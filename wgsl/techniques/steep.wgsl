@@ -4,7 +4,7 @@
 
 fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     fetch_count = 0u;
-    let n = u32(clamp(trace_params.layers, 1.0, LAYERS_MAX));
+    let n = clamp(trace_params.layers, LAYERS_MIN, LAYERS_MAX);
     let m = layer_march(uv0, v, lod, 0.0, n);
     return TraceResult(m.uv, m.t_start + f32(m.layers) * m.layer_step, fetch_count, is_grazing(v), n);
 }
