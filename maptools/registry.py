@@ -240,7 +240,7 @@ KINDS: dict[str, Kind] = {
     ),
     "distance": Kind(
         name="distance",
-        description="3D distance map (Donnelly), float32 (Dz, H, W): per voxel the distance from the voxel box to an "
+        description="3D distance map (Donnelly 2005), float32 (Dz, H, W): per voxel the distance from the voxel box to an "
                     "outer solid of sub-cell columns, in texels of u (v scaled by W/H, depth by S*W); a safe step for "
                     "a nearest lookup anywhere in the voxel; periodic in u, v",
         options=_VOLUME_OPTIONS,
@@ -271,7 +271,7 @@ KINDS: dict[str, Kind] = {
     ),
     "cone": Kind(
         name="cone",
-        description="relaxed cone map (Policarpo & Oliveira 2007), float32 (H, W): cone ratio in texels of u per "
+        description="relaxed cone map (Policarpo & Oliveira), float32 (H, W): cone ratio in texels of u per "
                     "unit of layer depth t, conservative for the bilinear surface (docs/maps.md)",
         options=(
             Option("max_ratio", 16.0, float, "largest stored ratio (texels per unit t); bounds the search to "
