@@ -21,7 +21,7 @@ from wgpuviewer.core.wgsl import Generated
 
 from .techniques import Param, Parametrized, resolve_params
 
-#: The default filter and derivative source: hardware trilinear on the unperturbed uv (what the renderer always did).
+#: The default filter and derivative source: hardware trilinear on the unperturbed uv: the plain hardware lookup.
 DEFAULT_FILTER = "trilinear"
 DEFAULT_DERIVATIVES = "uv"
 

@@ -1,5 +1,5 @@
 // Filter `trilinear` (the default): the hardware picks the level from the larger derivative and blends two
-// levels bilinearly. With the `uv` derivative source this is exactly what the renderer did before filters.
+// levels bilinearly. With the `uv` derivative source: the plain hardware lookup of the unperturbed footprint.
 // #include "common/footprint.wgsl"
 
 fn filter_texture(tex: texture_2d<f32>, fp: Footprint) -> vec4f {
