@@ -3,18 +3,15 @@ against float64 within the documented tolerance, and the study's GPU timing."""
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pytest
 
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.wgsl import read_wgsl
 from wgpuviewer.relief.renderer import Renderer  # noqa: F401 - imports wgpu before the log fixture touches its logger
 from wgpuviewer.studies.perspective import geometry as g
 from wgpuviewer.studies.perspective import methods as M
 from wgpuviewer.studies.perspective.hardware import hardware_uv, renderer_for
-from wgpuviewer.studies.perspective.kernels import PARAMS_SIZE, SPAN_STRIDE, kernels_for, pack_params, pack_spans
+from wgpuviewer.studies.perspective.kernels import PARAMS, SPAN, kernels_for, pack_params, pack_spans
 from wgpuviewer.studies.perspective.run import ulp_difference
 
 pytestmark = pytest.mark.requires_gpu
@@ -82,17 +79,17 @@ def test_the_rasteriser_is_not_asked_for_an_infinite_quad(gpu):
         renderer_for(g.build(g.Setup(span_length=64, rows=2, tilt=95.0)), gpu)
 
 
-def _struct_size(name: str) -> int:
-    """Byte size of a WGSL struct of vec4 and 32-bit scalar fields in common.wgsl."""
-    body = re.search(r"struct " + name + r" \{(.*?)\n\}", read_wgsl("studies/perspective/common.wgsl"), re.S).group(1)
-    body = re.sub(r"//[^\n]*", "", body)
-    sizes = {"vec4f": 16, "vec4i": 16, "vec2i": 8, "u32": 4, "i32": 4, "f32": 4}
-    return sum(sizes[t] for t in re.findall(r":\s*(\w+),", body))
-
-
-def test_the_packed_buffers_match_the_wgsl_structs():
-    quad = g.build(g.Setup(span_length=8, rows=2, tilt=45.0))
+def test_the_generated_records_hold_each_methods_inputs_by_field():
+    quad = g.build(g.Setup(span_length=8, rows=3, tilt=45.0))
+    k = quad.coefficients.astype(np.float32)
     for name in ("direct", "fixed16_16"):
         method = M.METHODS[name]
-        assert len(pack_params(method, quad.coefficients, quad.spans)) == PARAMS_SIZE == _struct_size("Params")
-        assert pack_spans(method, quad.coefficients, quad.spans).strides[0] == SPAN_STRIDE == _struct_size("Span")
+        params = PARAMS.unpack(pack_params(method, quad.coefficients, quad.spans))[0]
+        spans = SPAN.unpack(pack_spans(method, quad.coefficients, quad.spans))
+        assert np.array_equal(params["a"], k[:, 0]) and np.array_equal(params["c"], k[:, 2])
+        assert (params["span_length"], params["span_count"], params["param"]) == (8, 3, method.param)
+        assert np.array_equal(spans["y"], quad.spans.y) and len(spans) == 3
+        assert np.array_equal(spans["defined"].T, g.defined_range(quad.coefficients, quad.spans))
+        fixed = M.fixed_setup(quad.coefficients, quad.spans) if name == "fixed16_16" else None
+        assert np.array_equal(params["fixed_step"], fixed.steps if fixed else np.zeros(3))
+        assert np.array_equal(spans["fixed_start"], fixed.starts.T if fixed else np.zeros((3, 3)))

@@ -1,8 +1,10 @@
 """The methods as WGSL compute kernels (``wgsl/studies/perspective/kernels.wgsl``), run on spans and timed.
 
 One shader module holds every kernel; they share one bind group layout (the Params uniform, the spans, the per-span
-constants, the uv and flag outputs). ``Kernels.prepare`` uploads one method's inputs and returns a ``Dispatch`` that
-records the method's pass (for timing) and reads its output back as a ``methods.Result``.
+constants, the uv and flag outputs). The records Python and WGSL share, ``PARAMS`` and ``SPAN``, are
+``core.structs.Struct``s generated into the module and packed by field name. ``Kernels.prepare`` uploads one
+method's inputs and returns a ``Dispatch`` that records the method's pass (for timing) and reads its output back as
+a ``methods.Result``.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import wgpu
 
 from wgpuviewer.core.compute import compute_for, workgroups
 from wgpuviewer.core.gpu import Gpu
+from wgpuviewer.core.structs import Struct
 from wgpuviewer.core.wgsl import Generated
 
 from .geometry import Spans, defined_range
@@ -29,31 +32,42 @@ WORKGROUP = 64  # @workgroup_size of every kernel
 #: What a user can do when a kernel does not build on their adapter, or the spans do not fit its limits.
 FIX = "run on another adapter (--backend)"
 FEWER = "use fewer spans"
-PARAMS_SIZE = 6 * 16 + 16  # six vec4 + span_length, span_count, param, one (common.wgsl's Params)
-SPAN_STRIDE = 32  # common.wgsl's Span
+#: The uniform P (``common.wgsl``): the polygon's coefficients as columns over the quantities (w_u, w_v, q), what
+#: the fixed-point and double-single forms add, the spans' size and the method's parameter.
+PARAMS = Struct("Params", [
+    ("a", "vec3f"), ("b", "vec3f"), ("c", "vec3f"),  # A1, A2, D / B1, B2, E / C1, C2, F: the x, y and constant terms
+    ("a_lo", "vec3f"),  # double_single: the float64 x coefficients minus a (their f32 parts)
+    ("fixed_step", "vec3i"),  # fixed16_16: the x coefficients in 16.16 units of each quantity's scale
+    ("fixed_ratio", "vec2f"),  # fixed16_16: scale(q) / scale(w_u), scale(q) / scale(w_v) (powers of two)
+    ("span_length", "u32"), ("span_count", "u32"),
+    ("param", "u32"),  # k (parallel), S (subdivided) or M (reanchor)
+    ("one", "f32")])  # 1.0 from the host: a factor the compiler cannot fold (arith.Arith.guard)
+#: One span of the read-only ``spans`` array.
+SPAN = Struct("Span", [
+    ("x0", "i32"), ("y", "i32"),
+    ("defined", "vec2i"),  # the span setup's clip (geometry.defined_range): pixels n in [x, y) are computed
+    ("fixed_start", "vec3i")], "storage")  # fixed16_16: w_u, w_v, q at n = 0 in 16.16 units
 
 
 def pack_params(method: Method, coefficients: np.ndarray, spans: Spans) -> bytes:
     k64 = np.asarray(coefficients, np.float64)
     k = k64.astype(np.float32)
-    columns = np.zeros((4, 4), np.float32)  # a, b, c, a_lo
-    columns[0, :3], columns[1, :3], columns[2, :3] = k[:, 0], k[:, 1], k[:, 2]
-    columns[3, :3] = split(k64)[1][:, 0]
-    steps, ratio = np.zeros(4, np.int32), np.zeros(4, np.float32)
+    fixed_step, fixed_ratio = np.zeros(3, np.int32), np.zeros(2, np.float32)
     if method.kernel == "fixed16_16":
         fx = fixed_setup(k64, spans)
-        steps[:3], ratio[:2] = fx.steps, fx.ratio
-    tail = np.array([spans.length, spans.count, method.param], np.uint32).tobytes() + np.float32(1.0).tobytes()
-    return columns.tobytes() + steps.tobytes() + ratio.tobytes() + tail
+        fixed_step, fixed_ratio = fx.steps, fx.ratio
+    return PARAMS.pack({"a": k[:, 0], "b": k[:, 1], "c": k[:, 2], "a_lo": split(k64)[1][:, 0],
+                        "fixed_step": fixed_step, "fixed_ratio": fixed_ratio, "span_length": spans.length,
+                        "span_count": spans.count, "param": method.param, "one": 1.0})
 
 
-def pack_spans(method: Method, coefficients: np.ndarray, spans: Spans) -> np.ndarray:
-    data = np.zeros((spans.count, SPAN_STRIDE // 4), np.int32)
-    data[:, 0], data[:, 1] = spans.x0, spans.y
-    data[:, 2], data[:, 3] = defined_range(coefficients, spans)
+def pack_spans(method: Method, coefficients: np.ndarray, spans: Spans) -> bytes:
+    records = np.zeros(spans.count, SPAN.dtype)
+    records["x0"], records["y"] = spans.x0, spans.y
+    records["defined"] = np.stack(defined_range(coefficients, spans), axis=1)
     if method.kernel == "fixed16_16":
-        data[:, 4:7] = fixed_setup(coefficients, spans).starts.T
-    return data
+        records["fixed_start"] = fixed_setup(coefficients, spans).starts.T
+    return SPAN.pack_many(records)
 
 
 def kernels_for(gpu: Gpu) -> Kernels:
@@ -79,7 +93,8 @@ class Kernels:
         ])
         forms = "".join(f"const FORM_{name.upper()}: u32 = {form}u;\n" for name, (_, form) in FORMS.items())
         self.kernel = self.compute.kernel(
-            Generated("<generated: kernel forms>", forms), SOURCE, label="perspective", fix=FIX,
+            Generated("<generated: kernel forms>", forms), PARAMS.generated(), SPAN.generated(), SOURCE,
+            label="perspective", fix=FIX,
             layout=device.create_pipeline_layout(label="perspective", bind_group_layouts=[self.layout]))
 
     def pipeline(self, kernel: str) -> wgpu.GPUComputePipeline:

@@ -1,6 +1,6 @@
-// The perspective study's kernel interface (wgpuviewer/studies/perspective/kernels.py packs it): the polygon's
-// coefficients as three columns over the quantities (w_u, w_v, q), the spans, the outputs, and what every
-// method shares: the per-span constants and the flagged store.
+// The perspective study's kernel interface (wgpuviewer/studies/perspective/kernels.py declares and packs its
+// records): the polygon's coefficients as three columns over the quantities (w_u, w_v, q), the spans, the
+// outputs, and what every method shares: the per-span constants and the flagged store.
 // Pixel (x0 + n, y) of a span: w = a * x + b * y + c componentwise; u = w.x / w.z, v = w.y / w.z (texels).
 
 // |u| or |v| beyond this has no fractional bits left in f32: the pixel is flagged (geometry.UMAX).
@@ -9,25 +9,7 @@ const UMAX: f32 = 16777216.0;
 const MAX_SPAN: u32 = 16384u;
 const MAX_THREADS: u32 = 32u;
 
-struct Params {
-    a: vec4f,            // A1, A2, D (xyz): the x coefficients
-    b: vec4f,            // B1, B2, E: the y coefficients
-    c: vec4f,            // C1, C2, F: the constants
-    a_lo: vec4f,         // double_single: the f64 x coefficients minus a (their f32 parts)
-    fixed_step: vec4i,   // fixed16_16: the x coefficients in 16.16 units of each quantity's scale
-    fixed_ratio: vec4f,  // fixed16_16: scale(q) / scale(w_u), scale(q) / scale(w_v) (powers of two)
-    span_length: u32,
-    span_count: u32,
-    param: u32,          // k (parallel), S (subdivided) or M (reanchor)
-    one: f32,            // 1.0 from the host: a factor the compiler cannot fold (arith.Arith.guard)
-}
-
-struct Span {
-    x0: i32,
-    y: i32,
-    defined: vec2i,      // the span setup's clip (geometry.defined_range): pixels n in [x, y) are computed
-    fixed_start: vec4i,  // fixed16_16: w_u, w_v, q at n = 0 in 16.16 units
-}
+// Params (P) and Span are generated into the module from kernels.py's PARAMS and SPAN (core.structs).
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read> spans: array<Span>;
@@ -41,7 +23,7 @@ fn span_len() -> u32 {
 
 // a * x + b * y + c, in that order: the opaque factor P.one keeps the compiler from reassociating the sum.
 fn linear(x: f32, y: f32) -> vec3f {
-    return (P.a.xyz * x + P.b.xyz * y) * P.one + P.c.xyz;
+    return (P.a * x + P.b * y) * P.one + P.c;
 }
 
 // ut_u, ut_v, ub: the per-span constants a * x0 + b * y + c.

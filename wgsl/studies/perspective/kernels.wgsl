@@ -19,7 +19,7 @@ fn per_pixel(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     switch FORM {
-        case FORM_SPAN: { store(s, n, starts[s].xyz + P.a.xyz * f32(n)); }
+        case FORM_SPAN: { store(s, n, starts[s].xyz + P.a * f32(n)); }
         default: { store(s, n, linear(f32(spans[s].x0 + i32(n)), f32(spans[s].y))); }
     }
 }
@@ -54,7 +54,7 @@ fn incremental(s: u32) {
     var w = span_start(s);
     for (var n = 0u; n < span_len(); n++) {
         store(s, n, w);
-        w = w + P.a.xyz;
+        w = w + P.a;
     }
 }
 
@@ -70,9 +70,9 @@ fn parallel(@builtin(global_invocation_id) gid: vec3u) {
     }
     var w = span_start(s);
     for (var i = 0u; i < j; i++) {
-        w = w + P.a.xyz;
+        w = w + P.a;
     }
-    let stride = P.a.xyz * f32(k);
+    let stride = P.a * f32(k);
     for (var r = 0u; r < MAX_SPAN; r++) {
         let n = j + r * k;
         if n >= span_len() {
@@ -96,8 +96,8 @@ fn two_ended(@builtin(global_invocation_id) gid: vec3u) {
     let len = span_len();
     let half = (len + 1u) / 2u;
     let start = span_start(s);
-    var w = select(start, start + P.a.xyz * f32(len - 1u), down);
-    let step = select(P.a.xyz, -P.a.xyz, down);
+    var w = select(start, start + P.a * f32(len - 1u), down);
+    let step = select(P.a, -P.a, down);
     let count = select(half, len - half, down);
     for (var r = 0u; r < count; r++) {
         store(s, select(r, len - 1u - r, down), w);
@@ -111,7 +111,7 @@ struct Anchor {
 }
 
 fn anchor(s: u32, start: vec3f, n: u32) -> Anchor {
-    let w = start + P.a.xyz * f32(n);
+    let w = start + P.a * f32(n);
     let flagged = !is_defined(w) || clipped(s, n);
     return Anchor(select(w.xy / w.z, vec2f(0.0), flagged), flagged);
 }
@@ -154,10 +154,10 @@ fn reanchor(s: u32) {
     var w = start;
     for (var n = 0u; n < span_len(); n++) {
         if n % every == 0u {
-            w = start + P.a.xyz * f32(n);
+            w = start + P.a * f32(n);
         }
         store(s, n, w);
-        w = w + P.a.xyz;
+        w = w + P.a;
     }
 }
 
@@ -167,7 +167,7 @@ fn kahan(s: u32) {
     var comp = vec3f(0.0);
     for (var n = 0u; n < span_len(); n++) {
         store(s, n, sum);
-        let y = P.a.xyz - comp;
+        let y = P.a - comp;
         let t = sum + y;
         comp = (t * P.one - sum) - y;
         sum = t;
@@ -180,10 +180,10 @@ fn double_single(s: u32) {
     var lo = vec3f(0.0);
     for (var n = 0u; n < span_len(); n++) {
         store(s, n, hi + lo);
-        let sum = (hi + P.a.xyz) * P.one;
+        let sum = (hi + P.a) * P.one;
         let bb = (sum - hi) * P.one;
-        let err = (hi - (sum - bb)) + (P.a.xyz - bb);
-        let e = err + (lo + P.a_lo.xyz);
+        let err = (hi - (sum - bb)) + (P.a - bb);
+        let e = err + (lo + P.a_lo);
         hi = (sum + e) * P.one;
         lo = e - (hi - sum);
     }
@@ -191,11 +191,11 @@ fn double_single(s: u32) {
 
 // Formula (4) in int32 16.16 fixed point (wrapping adds, as the numpy twin's int32 sums).
 fn fixed16_16(s: u32) {
-    var w = spans[s].fixed_start.xyz;
+    var w = spans[s].fixed_start;
     for (var n = 0u; n < span_len(); n++) {
         let f = vec3f(w);
         let uv = vec2f((f.x / f.z) * P.fixed_ratio.x, (f.y / f.z) * P.fixed_ratio.y);
         store_uv(s, n, uv, !(f.z > 0.0 && abs(uv.x) <= UMAX && abs(uv.y) <= UMAX) || clipped(s, n));
-        w = w + P.fixed_step.xyz;
+        w = w + P.fixed_step;
     }
 }
