@@ -1,16 +1,20 @@
 """Content-addressed cache of generated maps, for the renderer.
 
 Key = sha256 of (array bytes, shape, dtype, kind, resolved options, the kind's kernel source hash, maptools
-VERSION): an edited kernel, or a file it includes, gets new keys by itself; VERSION tracks the CPU reference. Keys of
-kinds outside the registry (the renderer's auto table) hold their own version in their options. The backend is not
-part of the key: GPU and CPU results agree within each kind's documented tolerance.
-Files: ``$WGPUVIEWER_CACHE_DIR`` (default ``~/.cache/wgpuviewer/maps``) / KIND / KEY[:2] / KEY.npy|.npz,
-written atomically (a concurrent reader never sees a partial file).
+VERSION, the entry format): an edited kernel, or a file it includes, gets new keys by itself; VERSION tracks the CPU
+reference. Keys of kinds outside the registry (the renderer's auto table) hold their own version in their options.
+The backend is not part of the key: GPU and CPU results agree within each kind's documented tolerance.
+Files: ``$WGPUVIEWER_CACHE_DIR`` (default ``~/.cache/wgpuviewer/maps``) / KIND / KEY[:2] / KEY.npz, written
+atomically (a concurrent reader never sees a partial file). Each entry holds its map (``map``, or ``level0`` ...
+for a list of arrays), its key and a sha256 of both; a read checks them, and an entry that fails (overwritten,
+truncated, another map's file) is rebuilt with one warning line saying so.
 
 Size: at most ``$WGPUVIEWER_CACHE_MAX`` bytes (default 2G; suffixes K, M, G, T; 0 turns the cap off); after
-each write the least recently used maps (a hit touches its file) are evicted until the cache fits.
-``maptools cache info`` shows it, ``maptools cache clean [--older-than 7d]`` empties it.
-A cache folder that cannot be written is a warning (maps are then rebuilt each run), never an error.
+each write the least recently used maps (a hit touches its file) are evicted until the cache fits. Both variables
+are parsed by ``wgpuviewer.core.env``.
+``maptools cache info`` shows it, ``maptools cache clean [--older-than 7d]`` empties it; both refuse a cache path
+that is not a folder. A cache folder that cannot be written is a warning for the renderer (maps are then rebuilt
+each run), never an error.
 """
 
 from __future__ import annotations
@@ -20,58 +24,54 @@ import hashlib
 import json
 import logging
 import os
-import re
+import stat
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from wgpuviewer.core import env
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import WriteError, atomic_open, remove_abandoned_temps
 
 from . import VERSION, generate, validate_height
-from .io import read_maxmip, write_maxmip
 from .registry import KINDS, get_kind
 
-CACHE_ENV = "WGPUVIEWER_CACHE_DIR"
-CACHE_MAX_ENV = "WGPUVIEWER_CACHE_MAX"
-DEFAULT_CACHE_MAX = "2G"
-_UNITS = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
+CACHE_ENV = env.CACHE_DIR.name
+CACHE_MAX_ENV = env.CACHE_MAX.name
+#: The entry layout (module docstring); part of every key, so entries of an older layout are never read (they age
+#: out through eviction or ``cache clean``).
+ENTRY_FORMAT = 2
+#: Member names an entry keeps next to its map.
+_KEY, _CHECKSUM = "key", "sha256"
 
 log = logging.getLogger("maptools.cache")
 _warned: set[str] = set()
 
 
 def cache_dir() -> Path:
-    return Path(os.environ.get(CACHE_ENV) or Path.home() / ".cache" / "wgpuviewer" / "maps")
-
-
-def parse_size(text: str, what: str) -> int:
-    """'500M', '2G', '1.5T', '123' (bytes), '2GiB' -> bytes; a UserError naming ``what`` otherwise."""
-    match = re.fullmatch(r"\s*(\d+(?:\.\d*)?)\s*([KMGT]?)(?:I?B)?\s*", text, re.IGNORECASE)
-    if not match:
-        raise UserError(f"{what} = {text!r}: expected a size such as 500M, 2G or 0 (no cap)")
-    return int(float(match[1]) * _UNITS[match[2].upper()])
+    return env.CACHE_DIR.value() or Path.home() / ".cache" / "wgpuviewer" / "maps"
 
 
 def cache_limit() -> int:
     """The size cap in bytes (0: none)."""
-    return parse_size(os.environ.get(CACHE_MAX_ENV) or DEFAULT_CACHE_MAX, f"${CACHE_MAX_ENV}")
+    return env.CACHE_MAX.value()
 
 
 def cache_key(kind: str, height: np.ndarray, options: dict) -> str:
     a = np.ascontiguousarray(height)
     h = hashlib.sha256()
     h.update(json.dumps({"shape": list(a.shape), "dtype": str(a.dtype), "kind": kind,
-                         "options": options, "version": VERSION,
+                         "options": options, "version": VERSION, "format": ENTRY_FORMAT,
                          "kernels": KINDS[kind].source_hash() if kind in KINDS else None}, sort_keys=True).encode())
     h.update(memoryview(a).cast("B"))  # the bytes as they are, no copy
     return h.hexdigest()
 
 
 def cache_path(kind: str, key: str) -> Path:
-    return cache_dir() / kind / key[:2] / (key + (".npz" if kind == "maxmip" else ".npy"))
+    return cache_dir() / kind / key[:2] / (key + ".npz")
 
 
 @dataclass(frozen=True)
@@ -120,9 +120,28 @@ def evict(limit: int, keep: Path | None = None) -> list[Entry]:
     return removed
 
 
+def require_folder() -> Path:
+    """The cache folder for ``cache info``/``clean``: one that does not exist yet is an empty cache; a path that is
+    a file, or lies under one, is a UserError (not "0 maps")."""
+    root = cache_dir()
+    fix = f"set ${CACHE_ENV} to a folder, or unset it for the default {env.CACHE_DIR.default_text}"
+    try:
+        mode = root.stat().st_mode
+    except FileNotFoundError:
+        return root
+    except NotADirectoryError:
+        raise UserError(f"map cache {root}: part of the path is a file, not a folder; {fix}") from None
+    except OSError as error:
+        raise UserError(f"map cache {root}: cannot read ({error.strerror or error}); {fix}") from None
+    if not stat.S_ISDIR(mode):
+        raise UserError(f"map cache {root} is not a folder; {fix}")
+    return root
+
+
 def clean(older_than: float | None = None) -> list[Entry]:
     """Remove every cached map, or those not used for more than ``older_than`` seconds; abandoned temp files
     (of killed writers) go too. Returns the maps removed."""
+    require_folder()
     cutoff = None if older_than is None else time.time() - older_than
     removed = [e for e in entries() if (cutoff is None or e.last_used < cutoff) and _remove(e)]
     for folder in cache_dir().glob("*/*"):
@@ -138,37 +157,86 @@ def _warn_once(reason: str) -> None:
                     f"set {CACHE_ENV} to a writable folder")
 
 
-def _load(kind: str, path: Path):
-    result = read_maxmip(path) if kind == "maxmip" else np.load(path, allow_pickle=False)
-    with contextlib.suppress(OSError):  # a read-only cache still serves
-        os.utime(path)  # a hit: most recently used now
+class DamagedEntry(Exception):
+    """A cache entry that does not hold what its key names; the message says how."""
+
+
+def _members(result) -> dict[str, np.ndarray]:
+    """An entry's arrays by name: one array as ``map``, a list of arrays (maxmip) as ``level0`` ... in order."""
+    if isinstance(result, np.ndarray):
+        return {"map": result}
+    return {f"level{i}": np.asarray(a) for i, a in enumerate(result)}
+
+
+def _checksum(key: str, members: dict[str, np.ndarray]) -> str:
+    h = hashlib.sha256(key.encode())
+    for name, a in members.items():
+        a = np.ascontiguousarray(a)
+        h.update(f"{name} {a.dtype.str} {a.shape}".encode())
+        h.update(a.reshape(-1).view(np.uint8))
+    return h.hexdigest()
+
+
+def read_entry(path: Path, key: str):
+    """The map of the entry at ``path``, checked against ``key`` and its checksum; DamagedEntry otherwise."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            stored = {name: z[name] for name in z.files}
+    except Exception as error:  # noqa: BLE001 - whatever a cut or overwritten file raises
+        raise DamagedEntry(f"unreadable: {type(error).__name__}: {error}") from None
+    if _KEY not in stored or _CHECKSUM not in stored:
+        raise DamagedEntry("no key or checksum in it")
+    if str(stored.pop(_KEY)) != key:
+        raise DamagedEntry("it holds another map")
+    checksum = str(stored.pop(_CHECKSUM))
+    if "map" in stored and len(stored) == 1:
+        result = stored["map"]
+    else:
+        try:
+            result = [stored[f"level{i}"] for i in range(len(stored))]
+        except KeyError:
+            raise DamagedEntry(f"unexpected arrays {', '.join(sorted(stored))}") from None
+    if _checksum(key, _members(result)) != checksum:
+        raise DamagedEntry("checksum mismatch: its data changed after it was written")
     return result
 
 
-def cached_generate(kind: str, height, backend: str = "auto", **options):
-    """Like :func:`maptools.generate`, but returns a cached result when the same input was seen before."""
-    k = get_kind(kind)
-    opts = k.resolve(options)
-    h = validate_height(height)
-    path = cache_path(kind, cache_key(kind, h, opts))
+def write_entry(f, key: str, result) -> None:
+    """An entry of ``result`` under ``key`` into the binary file ``f`` (read back by ``read_entry``)."""
+    members = _members(result)
+    np.savez(f, **members, **{_KEY: np.array(key), _CHECKSUM: np.array(_checksum(key, members))})
+
+
+def cached(kind: str, key: str, build: Callable[[], object]):
+    """The map cached as ``kind``/``key`` when its entry checks out (``read_entry``), else ``build()``'s result,
+    stored (a damaged entry: rebuilt, with one warning line saying so)."""
+    path = cache_path(kind, key)
     if path.is_file():
         try:
-            return _load(kind, path)
-        except Exception:  # noqa: BLE001 - a damaged cache entry is regenerated
-            pass
+            result = read_entry(path, key)
+        except DamagedEntry as damage:
+            log.warning(f"map cache: {path} is damaged ({damage}); rebuilding it")
+        else:
+            with contextlib.suppress(OSError):  # a read-only cache still serves
+                os.utime(path)  # a hit: most recently used now
+            return result
     limit = cache_limit()  # a bad $WGPUVIEWER_CACHE_MAX is a user error before the work, not after it
-    result = generate(kind, h, backend=backend, **opts)
+    result = build()
     try:
         with atomic_open(path) as f:
-            if kind == "maxmip":
-                write_maxmip(f, result, ".npz")
-            else:
-                np.save(f, result)
+            write_entry(f, key, result)
     except WriteError as error:  # read-only, full, not a folder: the map is still good
         _warn_once(error.strerror)
         return result
     evict(limit, keep=path)
     return result
+
+
+def cached_generate(kind: str, height, backend: str = "auto", **options):
+    """Like :func:`maptools.generate`, but returns a cached result when the same input was seen before."""
+    opts = get_kind(kind).resolve(options)
+    h = validate_height(height)
+    return cached(kind, cache_key(kind, h, opts), lambda: generate(kind, h, backend=backend, **opts))
 
 
 def _size(n: float) -> str:
@@ -188,10 +256,12 @@ def _age(seconds: float) -> str:
 
 def describe() -> str:
     """``maptools cache info``: where, how big, the cap, per kind."""
+    require_folder()
     found = entries()
     limit = cache_limit()
-    source = f"${CACHE_ENV}" if os.environ.get(CACHE_ENV) else f"default; set ${CACHE_ENV} to move it"
-    cap = f"{_size(limit)} (${CACHE_MAX_ENV}, default {DEFAULT_CACHE_MAX})" if limit else f"none (${CACHE_MAX_ENV}=0)"
+    source = f"${CACHE_ENV}" if env.CACHE_DIR.raw() else f"default; set ${CACHE_ENV} to move it"
+    cap = (f"{_size(limit)} (${CACHE_MAX_ENV}, default {env.CACHE_MAX.default_text})" if limit
+           else f"none (${CACHE_MAX_ENV}=0)")
     lines = [f"map cache: {cache_dir()} ({source})",
              f"size cap: {cap}; the least recently used maps are evicted beyond it"]
     kinds: dict[str, list[Entry]] = {}

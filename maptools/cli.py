@@ -55,17 +55,26 @@ def _parse_kinds(text: str | None) -> list[str]:
     return list(dict.fromkeys(names))
 
 
-def _parse_sets(items: list[str] | None) -> dict[str, dict]:
-    """--set KIND.OPTION=VALUE (repeatable) -> {kind: {option: value}}."""
-    out: dict[str, dict] = {}
+def kind_options(kinds: list[str], items: list[str] | None) -> dict[str, dict]:
+    """The resolved options of each selected kind from --set KIND.OPTION=VALUE (repeatable). Every --set is
+    validated like a selected kind's, then one naming a kind that is not selected is refused: it would change
+    nothing, and a batch that silently ignores an option is discovered only when its maps are used."""
+    sets: dict[str, dict] = {}
+    given: dict[str, str] = {}
     for item in items or []:
         head, eq, value = item.partition("=")
         kind, dot, opt = head.partition(".")
         if not eq or not dot:
             raise UserError(f"--set {item!r}: expected KIND.OPTION=VALUE, e.g. complexity.levels=16")
         get_kind(kind)
-        out.setdefault(kind, {})[opt.replace("-", "_")] = value
-    return out
+        sets.setdefault(kind, {})[opt.replace("-", "_")] = value
+        given.setdefault(kind, item)
+    resolved = {k: get_kind(k).resolve(sets.get(k, {})) for k in dict.fromkeys([*sets, *kinds])}
+    for kind, item in given.items():
+        if kind not in kinds:
+            raise UserError(f"--set {item!r}: {kind} is not among the kinds selected ({', '.join(kinds)}); "
+                            f"add it to --kinds or drop the --set")
+    return {k: resolved[k] for k in kinds}
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -219,8 +228,7 @@ def up_to_date(out: Path, key: str) -> bool:
 
 def cmd_batch(args) -> int:
     kinds = _parse_kinds(args.kinds)
-    sets = _parse_sets(args.set)
-    kopts = {k: get_kind(k).resolve(sets.get(k, {})) for k in kinds}
+    kopts = kind_options(kinds, args.set)
     si, sn = parse_shard(args.shard)
     if args.jobs < 1:
         raise UserError(f"--jobs {args.jobs}: must be >= 1")
@@ -266,7 +274,8 @@ def cmd_batch(args) -> int:
                 if not args.force and up_to_date(out, key):
                     res.append((str(f), k, "skipped", "up to date"))
                     continue
-                remove_stale_temps(out)  # left by a killed earlier run: this job owns `out`
+                for owned in (out, sidecar(out)):  # left by a killed earlier run: this job owns both
+                    remove_stale_temps(owned)
                 if height is None:
                     height = read_height(f, args.channel, args.nan_policy)
                 result = generate(k, height, backend=backend, **kopts[k])
@@ -329,14 +338,13 @@ def cmd_check(args) -> int:
     from . import gpu
 
     kinds = _parse_kinds(args.kinds)
-    sets = _parse_sets(args.set)
+    kopts = kind_options(kinds, args.set)
     height = read_height(args.input, args.channel, args.nan_policy)
     g = gpu.runner()  # NoAdapterError (exit 2) when there is no GPU to check
     print(f"{args.input}: {height.shape[1]}x{height.shape[0]} on {g.gpu.summary}")
     bad = 0
     for k in kinds:
-        kind = get_kind(k)
-        opts = kind.resolve(sets.get(k, {}))
+        kind, opts = get_kind(k), kopts[k]
         c = kind.compare(kind.cpu(height, **opts), kind.gpu(height, **opts), opts)
         bad += not c.ok
         print(f"{k:<11} max {c.max_diff:.3g}  mean {c.mean_diff:.3g}  tolerance: {kind.tolerance}  "

@@ -43,13 +43,18 @@ def spacing(w: int, h: int, slices: int, height_scale: float) -> tuple[float, fl
     return 1.0, w / h, height_scale * w / slices
 
 
+#: What a maptools user can do about a volume beyond its limit (``check_volume``'s default fix).
+FEWER_SLICES = "downscale the height map or use fewer --slices"
+
+
 def check_volume(w: int, h: int, slices: int, kind: str = "distance", volumes: int = 1, limit: int = MAX_VOXELS,
-                 unit: str = "float32") -> None:
+                 unit: str = "float32", fix: str = FEWER_SLICES) -> None:
+    """A UserError when ``volumes`` volumes of w x h x slices hold more than ``limit`` values; ``fix`` names what the
+    caller's user can change (maptools' options by default; the renderer names the height map's size)."""
     n = w * h * slices * volumes
     if n > limit:
-        what = f"{volumes} volumes of {w}x{h}x{slices}" if volumes > 1 else f"a {w}x{h}x{slices} volume"
-        raise UserError(f"{kind}: {what} hold {n} values, more than the limit {limit} ({unit}); "
-                        f"downscale the height map or use fewer --slices")
+        what = f"{volumes} volumes of {w}x{h}x{slices} hold" if volumes > 1 else f"a {w}x{h}x{slices} volume holds"
+        raise UserError(f"{kind}: {what} {n} values, more than the limit {limit} ({unit}); {fix}")
 
 
 def vertex_depth(depth: np.ndarray, k: int) -> np.ndarray:

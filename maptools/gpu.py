@@ -13,7 +13,7 @@ import numpy as np
 
 from wgpuviewer.core.compute import compute_for
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.gpu import get_gpu
+from wgpuviewer.core.gpu import allocating, get_gpu
 from wgpuviewer.core.structs import Struct
 from wgpuviewer.core.wgsl import Module, compose
 
@@ -84,7 +84,10 @@ class MapGpu:
         self.compute.check_buffer(h * w * 4 * floats_per_texel, f"a {w}x{h} height map", f"downscale it or {FIX}")
 
     def storage(self, data_or_size, label: str):
-        return self.compute.storage(data_or_size, label, FIX)
+        """A storage buffer (``core.compute``'s limits checked); the adapter out of memory is a UserError."""
+        size = data_or_size if isinstance(data_or_size, int) else memoryview(data_or_size).nbytes
+        with allocating(self.gpu, label, size, FIX):
+            return self.compute.storage(data_or_size, label, FIX)
 
     def uniform(self, file: str, values: dict):
         """The Params uniform of kernel ``file`` holding ``values`` (every field, by name)."""

@@ -294,13 +294,20 @@ def window_tops(depth: np.ndarray, levels: int, sw: float) -> list[np.ndarray]:
     return out
 
 
-def check(w: int, h: int, slices: int, sectors: int, bands: int, kind: str = "distance_refined") -> int:
-    """Number of volumes (bins + the plain one), after checking the size limits."""
+#: What a maptools user can do about refined volumes beyond the limit (``check``'s default fix).
+FEWER_VALUES = "downscale the height map or use fewer --slices, --sectors or --bands"
+
+
+def check(w: int, h: int, slices: int, sectors: int, bands: int, kind: str = "distance_refined",
+          fix: str = FEWER_VALUES) -> int:
+    """Number of volumes (bins + the plain one), after checking the size limits: the refined kind's own total first
+    (with the default 33 volumes the stricter one), then the plain volume it starts from. ``fix``: what the
+    caller's user can change (maptools' options by default; the renderer names the height map's size)."""
     if sectors not in SECTOR_CHOICES:
         raise UserError(f"{kind}: option sectors={sectors}; expected one of {', '.join(map(str, SECTOR_CHOICES))}")
     volumes = sectors * bands + 1
-    dist.check_volume(w, h, slices, kind)
-    dist.check_volume(w, h, slices, kind, volumes, MAX_VALUES, "float16")
+    dist.check_volume(w, h, slices, kind, volumes, MAX_VALUES, "float16", fix)
+    dist.check_volume(w, h, slices, kind, fix=fix if fix != FEWER_VALUES else dist.FEWER_SLICES)
     return volumes
 
 

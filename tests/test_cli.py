@@ -122,7 +122,7 @@ def test_every_study_folder_is_a_registered_subcommand():
     assert {"view", "render", "techniques", "filters", "accuracy", "bench", "info"} <= set(commands)
 
 
-def test_a_discovered_study_runs_with_the_shared_options_and_its_command_line(monkeypatch, capsys):
+def test_a_discovered_study_runs_with_the_shared_options_and_its_command_line(monkeypatch, capsys, tmp_path):
     from wgpuviewer.harness import study as harness_study
 
     seen = {}
@@ -135,14 +135,20 @@ def test_a_discovered_study_runs_with_the_shared_options_and_its_command_line(mo
             harness_study.add_measurement_options(parser, "output folder", "smoke or full")
             parser.add_argument("--angles")
 
-        def run(self, args):
+        def options(self, args):
             seen.update(vars(args))
+            return args.angles
+
+        def run(self, options, out):
+            seen.update(options=options, folder=out)
             return 0
 
     monkeypatch.setattr(harness_study, "discover", lambda: [Probe()])
+    monkeypatch.chdir(tmp_path)  # the harness makes --out before the run
     assert main(["probe-study", "--out", "my runs", "--suite", "smoke", "--angles", "1,2"]) == 0
     assert seen["command_line"] == "wgpuviewer probe-study --out 'my runs' --suite smoke --angles 1,2"
     assert seen["suite"] == "smoke" and seen["out"] == "my runs" and seen["backend"] is None and not seen["quiet"]
+    assert seen["options"] == "1,2" and seen["folder"] == Path("my runs") and (tmp_path / "my runs").is_dir()
     assert main(["probe-study", "--suite", "smoke"]) == 2  # --out is required, as for every measuring command
     assert "required: --out" in capsys.readouterr().err
 

@@ -12,9 +12,9 @@ import pytest
 
 from tests.core.test_images import huge_exr
 from wgpuviewer import cli, textures
-from wgpuviewer.core.errors import FileError, UserError
+from wgpuviewer.core.errors import FileError, InputError, UserError
 from wgpuviewer.scene import default_scene_path, load_scene, with_folder_material
-from wgpuviewer.textures import file_role, find_material_files
+from wgpuviewer.textures import FOLDER_SLOTS, FolderFiles, file_role, find_material_files
 
 SIZE = 64
 
@@ -176,3 +176,70 @@ def test_view_material_without_a_display_renders_it(tmp_path, monkeypatch, capsy
     assert (tmp_path / "out" / "default_basic.png").is_file()
     assert cli.main(["view", "--material", str(tmp_path / "missing")]) == 2
     assert f"--material {tmp_path / 'missing'}: folder not found" in capsys.readouterr().err
+
+
+def test_keys_next_to_a_folder_win_over_its_files_for_their_slots(tmp_path):
+    """The folder is not searched for a slot the scene names: two height candidates, or a broken height link, do
+    not matter when the scene gives the height (or depth) itself."""
+    folder = make_folder(tmp_path, "generic")
+    write(folder / "height.png", relief()[0])  # a second height candidate next to bump.png
+    write(tmp_path / "mine.png", relief()[0][::-1])
+    with pytest.raises(FileError, match="2 candidates for the height: bump.png, height.png"):
+        find_material_files(folder)
+    found = find_material_files(folder, named={"height"})
+    assert (found.albedo.name, found.normal.name, found.height) == ("BaseColor.jpg", "normal.png", None)
+    assert find_material_files(folder, named=FOLDER_SLOTS) == FolderFiles(None, None, "opengl", None)
+    with pytest.raises(InputError, match="named \\['depth'\\]: expected slots among albedo, normal, height"):
+        find_material_files(folder, named={"depth"})
+    scene_path = tmp_path / "s.toml"
+    text = (default_scene_path().read_text()
+            .replace('albedo = { builtin = "bricks", size = [512, 512] }', 'folder = "generic"')
+            .replace('height = { builtin = "bricks", size = [512, 512] }', 'height = "mine.png"'))
+    scene_path.write_text(text)
+    material = load_scene(scene_path).materials["bricks"]
+    assert material.height.path.name == "mine.png" and material.albedo.path.name == "BaseColor.jpg"
+    scene_path.write_text(text.replace('height = "mine.png"', 'depth = "mine.png"'))
+    material = load_scene(scene_path).materials["bricks"]
+    assert material.height.path.name == "mine.png" and material.height_is_depth
+    (folder / "bump.png").unlink()
+    (folder / "height.png").unlink()
+    (folder / "height.png").symlink_to("gone.png")
+    assert find_material_files(folder, named={"height"}).height is None
+    with pytest.raises(FileError, match="broken link"):
+        find_material_files(folder)
+
+
+@pytest.mark.parametrize("case", ["dangling", "loop", "self loop", "folder"])
+def test_an_unusable_entry_named_for_a_slot_is_an_error_naming_it(tmp_path, capsys, case):
+    """It used to be dropped: a dangling height link rendered a flat surface with exit 0, and a folder of broken
+    links was "no albedo, normal or height file recognised"."""
+    folder = make_folder(tmp_path, "generic")
+    (folder / "bump.png").unlink()
+    bad = folder / "height.png"
+    if case == "dangling":
+        bad.symlink_to("missing.png")
+        reason = "height.png: broken link to missing.png (the target does not exist); fix or remove the link"
+    elif case == "loop":
+        (folder / "other.png").symlink_to("height.png")
+        bad.symlink_to("other.png")
+        reason = "height.png: symbolic link loop"
+    elif case == "self loop":
+        bad.symlink_to("height.png")
+        reason = "height.png: symbolic link loop"
+    else:
+        bad.mkdir()
+        reason = "height.png: a folder, not an image file"
+    with pytest.raises(FileError) as error:
+        find_material_files(folder)
+    assert error.value.reason.startswith(reason), error.value.reason
+    out = tmp_path / "x.png"
+    assert cli.main(["render", "--material", str(folder), "-o", str(out), "--size", "16x16",
+                     "--technique", "basic"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"wgpuviewer: error: --material {folder}: {error.value.reason}"], err
+    assert not out.exists()
+    for name in ("BaseColor.jpg", "normal.png"):  # a folder of nothing but broken links names them too
+        (folder / name).unlink()
+    (folder / "albedo.png").symlink_to("nowhere.png")
+    with pytest.raises(FileError, match="albedo.png: broken link to nowhere.png"):
+        find_material_files(folder)

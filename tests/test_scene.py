@@ -405,3 +405,51 @@ def test_load_scene_file_problems(tmp_path):
 def test_all_techniques_scene_lists_the_whole_registry():
     scene = load_scene(SCENES / "all_techniques.toml")
     assert scene.techniques == tuple(TECHNIQUES)
+
+
+# --- geometry float32 renders correctly ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("text,parts", [
+    # a plane far larger than its distance to the camera: float32 vertices land nowhere near the screen
+    (scene_text(objects=OBJECT.replace("[2.0, 2.0]", "[1e15, 1e15]")),
+     ["objects[0].size = [1000000000000000.0, 1000000000000000.0]: out of range, expected |position| + |size| / 2 "
+      "<= 6.554e+04", "65536 x the camera's distance to the object, here 1"]),
+    # the same camera distance far from the origin: the object's position is what float32 cannot place
+    (scene_text(camera="[camera]\nposition = [1e9, 1.0, 0.0]\ntarget = [1e9, 0.0, 0.5]\n",
+                objects=OBJECT + "position = [1e9, 0.0, 0.0]\n"),
+     ["objects[0].position = [1000000000.0, 0.0, 0.0]: out of range", "here 1;"]),
+    # a box the camera sits in: its distance is to the nearest face, 1 unit in front
+    (scene_text(objects="[[objects]]\ntype = 'box'\nmaterial = 'rock'\nsize = [1e7, 1e7, 8]\n"),
+     ["objects[0].size = [10000000.0, 10000000.0, 8]: out of range", "here 1;"]),
+    # a texture tiled so often that float32 texel coordinates skip texels
+    (scene_text(material=MATERIAL.replace("[0.5, 0.4, 0.3]", "{ builtin = 'bricks', size = [512, 256] }")
+                + "uv_scale = [1e5, 1e5]\n"),
+     ["materials.rock.uv_scale = [100000.0, 100000.0]: out of range for its 512x256 texture",
+      "expected uv_scale <= [32768, 65536]"]),
+])
+def test_geometry_float32_cannot_render_is_refused_with_the_range(tmp_path, text, parts):
+    error(tmp_path, text, *parts)
+
+
+def test_geometry_within_float32_range_loads(tmp_path):
+    """Large but renderable: a 1000-unit plane seen from 1 unit, a far camera looking at a small plane, tiling at
+    the limit, a tiny near plane (the box's distance, not the near plane, is the scale)."""
+    load(tmp_path, scene_text(objects=OBJECT.replace("[2.0, 2.0]", "[1e3, 1e3]")))
+    load(tmp_path, scene_text(camera="[camera]\nposition = [0.0, 1e9, 1e9]\ntarget = [0.0, 0.0, 0.0]\nfar = 1e10\n"
+                                     "near = 0.1\n"))
+    load(tmp_path, scene_text(material=MATERIAL.replace("[0.5, 0.4, 0.3]", "'builtin:bricks'")
+                              + "uv_scale = [65536, 65536]\n"))
+    load(tmp_path, scene_text(camera=CAMERA + "near = 1e-9\n"))
+
+
+def test_a_material_folder_keeps_the_scenes_tiling_only_where_float32_can(tmp_path):
+    from wgpuviewer.scene import with_folder_material
+
+    folder = tmp_path / "rock"
+    folder.mkdir()
+    cv2.imwrite(str(folder / "rock_Color.png"), np.full((512, 512, 3), 128, np.uint8))
+    scene = load(tmp_path, scene_text(material=MATERIAL + "uv_scale = [40000, 1]\n"))  # fine for a 1x1 colour
+    with pytest.raises(UserError, match=r"--material .*rock: the scene's uv_scale = \[40000.0, 1.0\] is out of "
+                                        r"range for its 512x512 texture"):
+        with_folder_material(scene, folder)

@@ -55,15 +55,19 @@ def has_display() -> bool:
 def render_to(out: Path, scene, technique: str, size: tuple[int, int], mode: str, backend: str | None,
               filtering: dict) -> None:
     """Render ``scene`` offscreen into ``out`` (.png or .npy), the maps it needs built first with a progress bar;
-    ``filtering``: the texture filter and derivative source (``pick_filtering``)."""
+    ``filtering``: the texture filter and derivative source (``pick_filtering``). A frame too large for the adapter
+    is refused (naming ``--size``) before any map is built."""
     from wgpuviewer.core.gpu import get_gpu
     from wgpuviewer.relief.output import save_output
-    from wgpuviewer.relief.renderer import Renderer
+    from wgpuviewer.relief.renderer import Renderer, check_frame_size
 
-    renderer = Renderer(scene, get_gpu(backend))
+    gpu = get_gpu(backend)
+    check_frame_size(gpu, size, "--size")
+    renderer = Renderer(scene, gpu)
     with terminal_progress(f"maps for {technique}") as progress:
         renderer.prepare(technique, progress)
-    save_output(out, renderer.render(renderer.config(technique, **filtering), size, mode=mode), mode)
+    image = renderer.render(renderer.config(technique, **filtering), size, mode=mode, size_name="--size")
+    save_output(out, image, mode)
 
 
 def cmd_render(args) -> int:

@@ -2,6 +2,7 @@
 
 Conventions: right-handed world, +Y up; angles in degrees; colours are linear RGB in [0, 1].
 Textures are only referenced here (textures.TextureRef); textures.py loads them lazily.
+Geometry is held to what the GPU's float32 renders correctly (``MAX_VIEW_RATIO``, ``MAX_TEXEL_COORDINATE``).
 Every problem is a one-line UserError naming the file, the key path, the value and what is
 expected. ``scenes/default.toml`` documents the format.
 """
@@ -14,11 +15,14 @@ from dataclasses import dataclass, replace
 from importlib.resources import files
 from pathlib import Path
 
+import numpy as np
+
 from wgpuviewer.core.errors import FileError, UserError
 from wgpuviewer.core.images import read_header
 from wgpuviewer.relief.techniques import TECHNIQUES, get_technique, resolve_params
 
-from .textures import BUILTINS, MAX_BUILTIN_SIZE, TextureRef, find_material_files
+from . import camera as cam
+from .textures import BUILTINS, FOLDER_SLOTS, MAX_BUILTIN_SIZE, TextureRef, find_material_files
 
 Vec3 = tuple[float, float, float]
 
@@ -104,6 +108,18 @@ OBJECT_SIZES = {"plane": 2, "quad": 2, "box": 3}
 MAX_LIGHTS = 256
 #: camera.far / camera.near at most: reversed-Z float depth separates surfaces over this range.
 MAX_DEPTH_RANGE = 1e12
+#: Float32 vertices. The GPU transforms vertices in float32 (24-bit significand): a vertex, or the camera, at
+#: distance P from the world origin lands within about P * 2^-24 of where it belongs, an angle of (P / d) * 2^-24
+#: seen from a distance d. Held to 2^-8 radian (a quarter of a degree, under 3 pixels of the default 1280x720
+#: frame at the default 60-degree field of view): P / d <= 2^16 for every object's reach |position| + |size| / 2,
+#: d being the camera's distance to the object (at least camera.near). The camera, within d of the object, is
+#: then within (2^16 + 1) d of the origin. Measured on the software adapter at 64x48 pixels: a plane 1 unit below
+#: the camera loses pixels from P / d = 7e5 on and vanishes beyond 2e7. (The perspective study's largest
+#: coordinate offset, 1e7 texels, reaches P / d = 2.2e4.)
+MAX_VIEW_RATIO = 2.0 ** 16
+#: Largest texel coordinate, uv_scale x the texture's side: beyond 2^24 float32's spacing exceeds one texel, so
+#: hit points skip texels and the texture tears.
+MAX_TEXEL_COORDINATE = 2 ** 24
 CHANNELS = ("auto", "r", "g", "b", "a")
 _MISSING = object()
 
@@ -331,6 +347,10 @@ def _material(src: str, name: str, data, base: Path) -> Material:
             raise t.error("channel", channel, "applies to a height/depth file only; expected no channel here")
         height = replace(height, channel=channel)
     default_y = folder["normal_y"] if folder is not None and "normal" not in t.data else "opengl"
+    uv_scale = t.vector("uv_scale", 2, [1.0, 1.0], lo=0, exclusive=True)
+    problem = _texel_coordinate_problem(uv_scale, (albedo, normal, height))
+    if problem:
+        raise t.error("uv_scale", t.data.get("uv_scale", list(uv_scale)), problem)
     return Material(
         name=name,
         albedo=albedo,
@@ -339,8 +359,31 @@ def _material(src: str, name: str, data, base: Path) -> Material:
         height=height,
         height_is_depth=is_depth,
         height_scale=t.number("height_scale", 0.05, 0, 1),
-        uv_scale=t.vector("uv_scale", 2, [1.0, 1.0], lo=0, exclusive=True),
+        uv_scale=uv_scale,
     )
+
+
+def _texture_size(ref: TextureRef | None) -> tuple[int, int]:
+    """(width, height) of a texture without loading it: a builtin's size, a file's header; 1x1 for a colour."""
+    if ref is None or ref.kind == "color":
+        return 1, 1
+    if ref.kind == "file":
+        header = read_header(ref.path)  # checked when the reference was made: cheap, and it does not fail here
+        return header.width, header.height
+    return ref.size
+
+
+def _texel_coordinate_problem(uv_scale: tuple[float, float], refs) -> str:
+    """Why ``uv_scale`` tiles the textures ``refs`` beyond MAX_TEXEL_COORDINATE ('' when it does not)."""
+    sizes = [_texture_size(ref) for ref in refs]
+    width, height = max(w for w, _ in sizes), max(h for _, h in sizes)
+    reach = max(uv_scale[0] * width, uv_scale[1] * height)
+    if reach <= MAX_TEXEL_COORDINATE:
+        return ""
+    most = [MAX_TEXEL_COORDINATE / width, MAX_TEXEL_COORDINATE / height]
+    return (f"out of range for its {width}x{height} texture: texel coordinates reach {reach:.3g}, beyond the "
+            f"{MAX_TEXEL_COORDINATE} up to which float32 addresses every texel; expected uv_scale <= "
+            f"[{most[0]:g}, {most[1]:g}]")
 
 
 def _folder(t: _Table, base: Path) -> dict | None:
@@ -353,16 +396,19 @@ def _folder(t: _Table, base: Path) -> dict | None:
     path = (base / Path(value).expanduser()).resolve()
     if not path.exists():
         raise t.error("folder", value, f"folder not found (looked for {path})")
+    # keys given next to the folder win: the folder is not searched for their slots (depth fills the height's)
+    named = [slot for slot in FOLDER_SLOTS if slot in t.data or (slot == "height" and "depth" in t.data)]
     try:
-        return folder_refs(path, f"{t.src}: {t.path('folder')} = {_show(value)}")
+        return folder_refs(path, f"{t.src}: {t.path('folder')} = {_show(value)}", named)
     except FileError as error:
         raise t.error("folder", value, error.reason) from None
 
 
-def folder_refs(path: Path, where: str) -> dict:
-    """albedo/normal/height TextureRefs (None where absent) and normal_y of the material folder ``path``; each
-    file's header checked; problems are reported against ``where`` (and the file's name)."""
-    found = find_material_files(path)
+def folder_refs(path: Path, where: str, named=()) -> dict:
+    """albedo/normal/height TextureRefs (None where absent or ``named``: given by the scene) and normal_y of the
+    material folder ``path``; each file's header checked; problems are reported against ``where`` (and the file's
+    name)."""
+    found = find_material_files(path, named)
     refs: dict = {"normal_y": found.normal_y}
     for slot in ("albedo", "normal", "height"):
         file = getattr(found, slot)
@@ -393,6 +439,9 @@ def with_folder_material(scene: Scene, folder: Path) -> Scene:
     if refs["albedo"] is None:
         raise UserError(f"{where}: no albedo file (NAME_Color, name_diff_1k, albedo, basecolor or diffuse)")
     old = scene.materials[scene.objects[plane].material]
+    problem = _texel_coordinate_problem(old.uv_scale, (refs["albedo"], refs["normal"], refs["height"]))
+    if problem:
+        raise UserError(f"{where}: the scene's uv_scale = {list(old.uv_scale)} is {problem}")
     name = f"folder {folder.name}"
     material = Material(name=name, albedo=refs["albedo"], normal=refs["normal"], normal_y=refs["normal_y"],
                         height=refs["height"], height_scale=old.height_scale, uv_scale=old.uv_scale)
@@ -415,6 +464,38 @@ def _object(src: str, key: str, data, materials: dict[str, Material]) -> SceneOb
         position=t.vector("position", 3, [0.0, 0.0, 0.0]),
         rotation=t.vector("rotation", 3, [0.0, 0.0, 0.0]),
     )
+
+
+_HALF_EXTENTS = {  # object kind -> its half extents (local x, y, z) from its size
+    "plane": lambda s: (s[0] / 2, 0.0, s[1] / 2),
+    "quad": lambda s: (s[0] / 2, s[1] / 2, 0.0),
+    "box": lambda s: (s[0] / 2, s[1] / 2, s[2] / 2),
+}
+
+
+def _distance_to(obj: SceneObject, point) -> float:
+    """Float64 distance from ``point`` to the surface of ``obj`` (a plane's or quad's rectangle, a box's faces)."""
+    rotation = cam.rotation_xyz(obj.rotation)[:3, :3]
+    local = np.abs(rotation.T @ (np.asarray(point, np.float64) - obj.position))
+    half = np.asarray(_HALF_EXTENTS[obj.kind](obj.size))
+    outside = float(np.linalg.norm(np.maximum(local - half, 0.0)))
+    return outside if outside > 0 else float(np.min(half - local))  # inside a box: to its nearest face
+
+
+def _check_geometry(src: str, camera: Camera, objects: tuple[SceneObject, ...], raw_objects: list[dict]) -> None:
+    """Every object within float32's range for the camera's view of it (MAX_VIEW_RATIO). The camera's own
+    |position| is then within (MAX_VIEW_RATIO + 1) times its distance to the nearest object: no check of its own."""
+    ratio = MAX_VIEW_RATIO
+    for i, (obj, raw) in enumerate(zip(objects, raw_objects, strict=True)):
+        d = max(_distance_to(obj, camera.position), camera.near)
+        offset = math.hypot(*obj.position)
+        reach = offset + math.hypot(*_HALF_EXTENTS[obj.kind](obj.size))
+        if reach > ratio * d:
+            key = "position" if offset > ratio * d else "size"
+            raise UserError(f"{src}: objects[{i}].{key} = {_show(raw.get(key, [0, 0, 0]))}: out of range, expected "
+                            f"|position| + |size| / 2 <= {ratio * d:.4g} (float32 places vertices within 1/4 degree "
+                            f"up to {ratio:.0f} x the camera's distance to the object, here {d:.4g}; it reaches "
+                            f"{reach:.4g})")
 
 
 def _techniques(root: _Table, section: _Table) -> tuple[str, tuple[str, ...], dict[str, dict]]:
@@ -472,11 +553,13 @@ def parse_scene(text: str, path: Path | str | None = None) -> Scene:
     if not raw_objects:
         raise root.error("objects", raw_objects, "expected at least one [[objects]] table")
     objects = tuple(_object(src, f"objects[{i}]", x, materials) for i, x in enumerate(raw_objects))
+    camera = _camera(root)
+    _check_geometry(src, camera, objects, raw_objects)
 
     return Scene(
         path=Path(path).resolve() if path is not None else None,
         name=section.string("name", Path(path).stem if path is not None else "scene"),
-        camera=_camera(root),
+        camera=camera,
         lights=lights or (DEFAULT_LIGHT,),  # absent or empty: one default light, never a black scene
         materials=materials,
         objects=objects,

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import contextlib
 import re
-from collections.abc import Callable
+import stat
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -18,8 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from wgpuviewer.core.color import srgb_to_linear
-from wgpuviewer.core.errors import FileError, UserError
-from wgpuviewer.core.images import MAX_SIDE, read_height, read_image
+from wgpuviewer.core.errors import FileError, InputError, UserError
+from wgpuviewer.core.images import MAX_SIDE, link_problem, read_height, read_image
 
 
 @dataclass(frozen=True)
@@ -295,6 +296,8 @@ def load_normal_map(ref: TextureRef, normal_y: str = "opengl") -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 # Material folders, as technical artists download them: each file's role is read from its name.
 
+#: The slots a material folder fills.
+FOLDER_SLOTS = ("albedo", "normal", "height")
 #: Files a material folder may contribute.
 FOLDER_EXTS = (".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".npy")
 #: Name tokens per slot (case-insensitive; names split at non-letters and camel case): ambientCG
@@ -340,17 +343,48 @@ class FolderFiles:
     height: Path | None
 
 
-def find_material_files(folder: Path) -> FolderFiles:
-    """The albedo, normal and height files of a material folder (``file_role``). Where a folder has both an
-    OpenGL and a DirectX normal map (ambientCG ships both), the OpenGL one is taken; two candidates for one slot
-    are an error listing them. Raises FileError (reason: what was found and the fix)."""
+def _entry_problem(path: Path) -> str | None:
+    """Why a folder entry named like a texture is no file to read (a broken link, a link loop, a folder), or None."""
+    problem = link_problem(path)
+    if problem is not None:
+        return problem
+    try:
+        mode = path.stat().st_mode
+    except OSError as e:
+        return f"cannot read ({e.strerror or e})"
+    if stat.S_ISDIR(mode):
+        return "a folder, not an image file; rename or remove it"
+    if not stat.S_ISREG(mode):
+        return "not a regular file; replace it with an image file"
+    return None
+
+
+def find_material_files(folder: Path, named: Collection[str] = ()) -> FolderFiles:
+    """The material folder's files (``file_role``) for each of FOLDER_SLOTS not in ``named``; the slots in
+    ``named`` are those the scene gives next to ``folder`` (they win: the folder is not searched for them, and
+    their slots are None here). Where a folder has both an OpenGL and a DirectX normal map (ambientCG ships both),
+    the OpenGL one is taken; two candidates for one slot are an error listing them; an entry named for a slot that
+    is no readable file (a broken link, a link loop, a folder) is an error naming it, never skipped. Raises
+    FileError (reason: what was found and the fix)."""
+    unknown = set(named) - set(FOLDER_SLOTS)
+    if unknown:
+        raise InputError(f"named {sorted(unknown)}: expected slots among {', '.join(FOLDER_SLOTS)}")
     if not folder.is_dir():
         raise FileError(folder, "not a folder; expected a material folder (e.g. an ambientCG or Poly Haven download)")
-    found: dict[str, list[tuple[Path, str]]] = {"albedo": [], "normal": [], "height": []}
-    for path in sorted(p for p in folder.iterdir() if p.is_file()):
+    searched = [slot for slot in FOLDER_SLOTS if slot not in named]
+    found: dict[str, list[tuple[Path, str]]] = {slot: [] for slot in FOLDER_SLOTS}
+    unusable = []
+    for path in sorted(folder.iterdir()):
         role = file_role(path)
-        if role is not None:
+        if role is None or role[0] not in searched:
+            continue
+        problem = _entry_problem(path)
+        if problem is None:
             found[role[0]].append((path, role[1]))
+        else:
+            unusable.append(f"{path.name}: {problem}")
+    if unusable:
+        raise FileError(folder, "; ".join(unusable))
     gl = [c for c in found["normal"] if c[1] == "opengl"]
     normals = gl or found["normal"]  # OpenGL first: the shader's convention, and ambientCG's NormalGL
     for slot, candidates in (("albedo", found["albedo"]), ("normal", normals), ("height", found["height"])):
@@ -358,8 +392,9 @@ def find_material_files(folder: Path) -> FolderFiles:
             names = ", ".join(p.name for p, _ in candidates)
             raise FileError(folder, f"{len(candidates)} candidates for the {slot}: {names}; keep one in the folder "
                                     f"or name the file in the scene ({slot} = \"...\")")
-    if not any(found.values()):
-        raise FileError(folder, "no albedo, normal or height file recognised by name (expected e.g. "
+    if searched and not any(found.values()):
+        slots = " or ".join(filter(None, (", ".join(searched[:-1]), searched[-1])))
+        raise FileError(folder, f"no {slots} file recognised by name (expected e.g. "
                                 "NAME_Color/NAME_NormalGL/NAME_Displacement, name_diff_1k/name_nor_gl_1k/name_disp_1k, "
                                 "or albedo/normal/height)")
     return FolderFiles(albedo=found["albedo"][0][0] if found["albedo"] else None,

@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
+from maptools import cli as maptools_cli
 from wgpuviewer.core.errors import FileError
 from wgpuviewer.core.images import MAX_SIDE, read_header, read_height, read_image
 
@@ -147,3 +148,92 @@ def test_nan_policies_report_how_many_texels_they_replaced(tmp_path, caplog):
         assert np.isfinite(out).all()
         assert f"n.npy: 3 of 20 texels were NaN/inf; replaced ({policy}: {what})" in caplog.text
         assert [(r.name, r.levelname) for r in caplog.records] == [("wgpuviewer.images", "WARNING")]
+
+
+def _damaged(tmp_path, fmt: str):
+    """A small PNG whose compressed data is damaged (its signature, header and CRCs intact), or a JPEG whose scan
+    data is: libpng cannot decode the one, libjpeg decodes the other with a complaint."""
+    rng = np.random.default_rng(0)
+    if fmt == "png":
+        pixels = (np.arange(32 * 32).reshape(32, 32) % 251).astype(np.uint8)
+        ok, data = cv2.imencode(".png", pixels)
+        data = bytearray(data.tobytes())
+        at = data.find(b"IDAT") + 10
+        data[at] ^= 0xFF
+        start = data.find(b"IDAT")
+        length = struct.unpack(">I", data[start - 4:start])[0]
+        data[start + 4 + length:start + 8 + length] = struct.pack(">I", zlib.crc32(data[start:start + 4 + length]))
+    else:
+        ok, data = cv2.imencode(".jpg", rng.integers(0, 255, (64, 64, 3), dtype=np.uint8))
+        data = bytearray(data.tobytes())
+        data[len(data) // 2:len(data) // 2 + 40] = b"\xff\x00" * 20
+    path = tmp_path / f"damaged.{fmt}"
+    path.write_bytes(bytes(data))
+    return path
+
+
+def test_a_decoder_complaint_is_part_of_our_one_line_not_a_line_of_its_own(tmp_path, capfd, caplog):
+    """libpng printed `libpng error: ...` on stderr ahead of our error line; libjpeg printed `Corrupt JPEG data`
+    and the damaged image was taken silently."""
+    png = _damaged(tmp_path, "png")
+    with pytest.raises(FileError) as error:
+        read_image(png)
+    assert str(error.value).startswith(f"{png}: cannot decode image (corrupt or unsupported png; the decoder said: "
+                                       "libpng error:"), str(error.value)
+    assert "\n" not in str(error.value)
+    capfd.readouterr()
+    assert maptools_cli.main(["generate", "normal", str(png), "-o", str(tmp_path / "n.png"), "--backend", "cpu"]) == 2
+    assert capfd.readouterr().err.splitlines() == [f"maptools: error: {error.value}"]
+    jpeg = _damaged(tmp_path, "jpeg")
+    assert read_image(jpeg).shape == (64, 64, 3)
+    err = capfd.readouterr().err.splitlines()  # only our own lines (a CLI's handler prints the warning as one)
+    assert not [line for line in err if line.startswith(("libpng", "Corrupt JPEG"))], err
+    warnings = [r.getMessage() for r in caplog.records if r.name == "wgpuviewer.images"]
+    assert len(warnings) == 1 and warnings[0].startswith(f"{jpeg}: decoded, but the jpeg decoder said: Corrupt JPEG "
+                                                         "data"), warnings
+
+
+def test_only_native_output_during_a_decode_is_taken(tmp_path, capfd, monkeypatch):
+    """Another thread's Python stderr (a warning) waits for the decode and then reaches the terminal; terminal
+    redraws (a progress bar) pass on; what the decoder writes on file descriptor 2 is taken."""
+    import os
+    import sys
+    import threading
+
+    from wgpuviewer.core import images
+
+    good = tmp_path / "good.png"
+    cv2.imwrite(str(good), np.zeros((4, 4), np.uint8))
+    other = threading.Thread(target=lambda: print("a warning of another thread", file=sys.stderr, flush=True))
+
+    def chatty(buf, flags):
+        other.start()  # it prints while the decode holds the descriptor
+        os.write(2, b"libfoo warning: something odd\n")
+        os.write(2, b"\r 40%|####      |")
+        return cv2.imdecode(buf, flags)
+
+    monkeypatch.setattr(sys, "stderr", sys.__stderr__)  # as in a CLI process: Python's stderr is descriptor 2
+    said = []
+    with images._native_stderr(said):
+        chatty(np.fromfile(good, np.uint8), cv2.IMREAD_UNCHANGED)
+    other.join(timeout=10)
+    err = capfd.readouterr().err
+    assert said == ["libfoo warning: something odd"]
+    # the two writers are not ordered against each other: each arrives whole
+    assert "a warning of another thread" in err and "\r 40%|####      |" in err and "libfoo" not in err
+    assert sys.stderr is sys.__stderr__
+
+
+@pytest.mark.parametrize("case", ["dangling", "loop"])
+def test_a_broken_link_is_named_as_one(tmp_path, case):
+    path = tmp_path / "height.png"
+    if case == "dangling":
+        path.symlink_to(tmp_path / "gone.png")
+        reason = f"broken link to {tmp_path / 'gone.png'} (the target does not exist); fix or remove the link"
+    else:
+        path.symlink_to("height.png")
+        reason = "symbolic link loop (the link leads back to itself); fix or remove the link"
+    for read in (read_header, read_image, read_height):
+        with pytest.raises(FileError) as error:
+            read(path)
+        assert error.value.reason == reason

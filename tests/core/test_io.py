@@ -1,11 +1,16 @@
 """Output paths (wgpuviewer.core.io): a folder where a file is expected, a full disk, a read-only folder, a file
-where a folder is expected: one line naming the path and the fix, exit 2, nothing left behind, on every CLI that
-writes. Stale temps: only abandoned ones are removed, never a live writer's."""
+where a folder is expected, an empty path: one line naming the path and the fix, exit 2, nothing left behind, on
+every CLI that writes. Stale temps: only abandoned ones of exactly our pattern are removed, never a live writer's
+nor a user's file. SIGTERM, like SIGINT, unwinds: a write in progress leaves no temp."""
 
 from __future__ import annotations
 
 import errno
 import os
+import signal
+import subprocess
+import sys
+import textwrap
 import threading
 
 import numpy as np
@@ -114,7 +119,7 @@ def test_stale_temps_of_live_writers_survive_cleanup(tmp_path):
     """Two writers of one output (threads here; processes behave alike: the lock is per open file): one's
     cleanup never removes the other's temp; a temp whose writer died (no lock) is removed."""
     out = tmp_path / "map.png"
-    abandoned = tmp_path / f".{out.name}.dead.tmp"
+    abandoned = tmp_path / f".{out.name}.killed_9.tmp"
     abandoned.write_bytes(b"left by a kill -9")
     writing, cleaned = threading.Event(), threading.Event()
 
@@ -158,3 +163,85 @@ def test_concurrent_batches_into_one_folder_never_fail_each_other(tmp_path, caps
         t.join(120)
     assert codes == [0, 0, 0], capsys.readouterr().out
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+
+def test_an_output_folder_is_refused_before_anything_is_made(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    for empty in ("", " "):
+        with pytest.raises(UserError, match=f"^--out {empty!r}: empty; give a folder path$"):
+            io.output_dir(empty, "--out")
+    dangling = tmp_path / "link"
+    dangling.symlink_to(tmp_path / "gone")
+    with pytest.raises(UserError, match="link: exists and is not a folder; give a folder path$"):
+        io.output_dir(dangling, "--out")
+    with pytest.raises(UserError, match="cannot write there .*the name is too long"):
+        io.output_dir(tmp_path / "new" / "deeper" / ("x" * 300), "--out")
+    assert sorted(os.listdir(tmp_path)) == ["link"]  # the folders made on the way were removed again
+    made = io.output_dir(tmp_path / "a" / "b", "--out")
+    assert made == tmp_path / "a" / "b" and made.is_dir() and list(made.iterdir()) == []
+
+
+def test_only_our_abandoned_temps_are_swept(tmp_path):
+    """The cleaners take exactly atomic_open's temp names (checked on a live one), unlocked, plain files."""
+    out = tmp_path / "plot.png"
+    writing, done = threading.Event(), threading.Event()
+
+    def writer():
+        with io.atomic_open(out) as f:
+            f.write(b"live")
+            writing.set()
+            done.wait(30)
+
+    thread = threading.Thread(target=writer)
+    thread.start()
+    assert writing.wait(30)
+    (live,) = temps(out)
+    assert io.TEMP_NAME.fullmatch(live.name)["target"] == "plot.png"
+    fd, stale = io.tempfile.mkstemp(prefix=".plot.png.", suffix=".tmp", dir=tmp_path)  # as a killed writer left it
+    os.close(fd)
+    users = [".notes.tmp", "draft.tmp", ".plot.png.mine.tmp", ".plot.png.ABCDEFGH.tmp", ".plot.png.abcdefgh.tmpx"]
+    for name in users:
+        (tmp_path / name).write_text("the user's")
+    (tmp_path / ".folder.abcdefgh.tmp").mkdir()
+    (tmp_path / ".link.abcdefgh.tmp").symlink_to(tmp_path / "draft.tmp")
+    assert io.remove_abandoned_temps(tmp_path) == 1 and not os.path.exists(stale)
+    assert io.remove_stale_temps(out) == 0 and live.exists()
+    done.set()
+    thread.join(30)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [*users, ".folder.abcdefgh.tmp", ".link.abcdefgh.tmp", "plot.png"])
+
+
+WRITER = textwrap.dedent("""
+    import sys, time
+    from wgpuviewer.core.cli import run_command
+    from wgpuviewer.core.io import atomic_open
+
+    def command():
+        with atomic_open(sys.argv[1]) as f:
+            f.write(b"partial")
+            f.flush()
+            print("writing", flush=True)
+            time.sleep(60)
+        return 0
+
+    sys.exit(run_command("maptools", command))
+""")
+
+
+@pytest.mark.parametrize("signum, code, word", [(signal.SIGTERM, 143, "terminated"), (signal.SIGINT, 130, "interrupted")])
+def test_a_signal_mid_write_leaves_no_temp(tmp_path, signum, code, word):
+    """SIGTERM (a service manager, `kill`, a CI timeout) is handled as SIGINT: the command unwinds, the temp of
+    the write in progress is removed, one line, its own exit code."""
+    out = tmp_path / "out" / "map.png"
+    proc = subprocess.Popen([sys.executable, "-c", WRITER, str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    try:
+        assert proc.stdout.readline().strip() == "writing"
+        assert len(temps(out)) == 1
+        proc.send_signal(signum)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    assert proc.returncode == code and err.strip() == f"maptools: {word}", err
+    assert list(out.parent.iterdir()) == []

@@ -1,18 +1,24 @@
 """The measurement harness: the typed results table (round trip, clear errors), the report header, the suites,
-study discovery and the plot context."""
+study discovery, the plot context, and the order every measuring command runs in (``run_study``: options, then
+the output folder, then the stale temps, then the measurement), on bench and every study alike."""
 
 from __future__ import annotations
 
+import argparse
 import datetime
+import importlib
 import math
+import os
 import sys
+import tempfile
 import textwrap
 
 import pytest
 
+from wgpuviewer import cli
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.harness.header import Clock, Header
-from wgpuviewer.harness.study import Study, discover
+from wgpuviewer.harness.study import Study, discover, run_study
 from wgpuviewer.harness.suite import Suite, pick, suites
 from wgpuviewer.harness.table import Column, Table
 
@@ -139,7 +145,10 @@ class _Study:
     def add_arguments(self, parser):
         parser.add_argument("--out")
 
-    def run(self, args):
+    def options(self, args):
+        return args
+
+    def run(self, options, out):
         return 0
 
 
@@ -175,3 +184,119 @@ def test_plot_context_saves_pngs_atomically(tmp_path):
         assert not plt.get_fignums()  # saved figures are closed
     assert (tmp_path / "p" / "a.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not list((tmp_path / "p").glob(".*.tmp"))
+
+
+# --- the order every measuring command runs in -------------------------------------------------------------------
+
+#: bench and every study: what ``wgpuviewer`` registers as measuring commands.
+COMMANDS = {study.name: study for study in cli.measurement_commands()}
+
+
+@pytest.fixture
+def measured(monkeypatch):
+    """Every measuring command's measurement (its ``run`` module's ``run``) replaced by a record of its calls: the
+    GPU never starts, so a test sees only what happens before it."""
+    calls = []
+    for name, study in COMMANDS.items():
+        module = importlib.import_module(type(study).__module__.rpartition(".")[0] + ".run")
+        monkeypatch.setattr(module, "run", lambda *args, name=name, **kwargs: calls.append(name) or [])
+    return calls
+
+
+def one_line(capsys) -> str:
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("wgpuviewer: error: "), lines
+    return lines[0].removeprefix("wgpuviewer: error: ")
+
+
+def _bad_out(kind: str, root) -> tuple[str, str]:
+    """An --out value of ``kind`` under ``root`` and the error every command gives for it."""
+    if kind == "empty":
+        return "", "--out '': empty; give a folder path"
+    if kind == "file":
+        (root / "file").write_text("x")
+        return str(root / "file"), f"--out {root / 'file'}: exists and is not a folder; give a folder path"
+    if kind == "dangling link":
+        (root / "link").symlink_to(root / "gone")
+        return str(root / "link"), f"--out {root / 'link'}: exists and is not a folder; give a folder path"
+    if kind == "under a file":
+        (root / "file").write_text("x")
+        return str(root / "file" / "sub"), (f"--out {root / 'file' / 'sub'}: cannot write there (Not a directory); "
+                                            f"a part of the path is a file, not a folder; choose another path")
+    long = root / "new" / ("x" * 300)
+    return str(long), f"--out {long}: cannot write there (File name too long); the name is too long; choose a " \
+                      f"shorter path"
+
+
+@pytest.mark.parametrize("kind", ["empty", "file", "dangling link", "under a file", "name too long"])
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_every_command_refuses_a_bad_out_alike_before_anything(tmp_path, monkeypatch, measured, capsys, command,
+                                                                 kind):
+    monkeypatch.chdir(tmp_path)  # an empty --out must not mean the current folder
+    out, message = _bad_out(kind, tmp_path)
+    before = sorted(os.listdir(tmp_path))
+    assert cli.main([command, "--out", out, "--suite", "smoke", "--quiet"]) == 2
+    assert one_line(capsys) == message
+    assert sorted(os.listdir(tmp_path)) == before and measured == []  # nothing made, nothing measured
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["refined-distance", "--heightmaps", "bricks,bogus"], "--heightmaps: unknown height map 'bogus'"),
+    (["refined-distance", "--angles", "86"], "--angles '86'"),
+    (["bench", "--heightmaps", "bogus"], "--heightmaps: unknown height map 'bogus'"),
+    (["bench", "--from-csv", "missing.csv"], "--from-csv missing.csv: no such file"),
+    (["filtering", "--reliefs", "lava"], "--reliefs: unknown relief 'lava'"),
+])
+def test_option_values_are_checked_before_the_output_folder_is_made(tmp_path, monkeypatch, measured, capsys, argv,
+                                                                    fragment):
+    monkeypatch.chdir(tmp_path)
+    assert cli.main([argv[0], "--out", "new", "--suite", "smoke", *argv[1:]]) == 2
+    assert fragment in one_line(capsys)
+    assert not (tmp_path / "new").exists() and measured == []
+
+
+def _our_temp(folder, name: str) -> str:
+    """A temp file as core.io.atomic_open names it, left as by a killed writer (unlocked)."""
+    fd, path = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=folder)
+    os.write(fd, b"partial")
+    os.close(fd)
+    return os.path.basename(path)
+
+
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_a_run_sweeps_the_temps_a_killed_run_left_and_nothing_else(tmp_path, measured, command):
+    out = tmp_path / "out"
+    out.mkdir()
+    stale = [_our_temp(out, "error_along_span.png"), _our_temp(out, "results.csv")]
+    kept = [".notes.tmp", "draft.tmp", ".results.csv.mine.tmp", ".results.csv.ABCDEFGH.tmp", "results.csv"]
+    for name in kept:
+        (out / name).write_text("the user's")
+    assert cli.main([command, "--out", str(out), "--suite", "smoke", "--quiet"]) == 0
+    assert measured == [command]
+    assert sorted(os.listdir(out)) == sorted(kept) and not any((out / name).exists() for name in stale)
+
+
+def test_run_study_checks_the_options_first_and_hands_the_measurement_a_made_folder(tmp_path):
+    seen = []
+
+    class Probe:
+        name, help = "probe", "records what it is given"
+
+        def add_arguments(self, parser):
+            pass
+
+        def options(self, args):
+            if args.bad:
+                raise UserError("--bad: refused")
+            return {"checked": True}
+
+        def run(self, options, out):
+            seen.append((options, out, out.is_dir()))
+            return 0
+
+    out = tmp_path / "a" / "b"
+    with pytest.raises(UserError, match="--bad"):
+        run_study(Probe(), argparse.Namespace(out=str(out), bad=True))
+    assert not (tmp_path / "a").exists() and seen == []
+    assert run_study(Probe(), argparse.Namespace(out=str(out), bad=False)) == 0
+    assert seen == [({"checked": True}, out, True)]

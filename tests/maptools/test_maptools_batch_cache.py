@@ -5,6 +5,7 @@ cache is a warning, not an error."""
 from __future__ import annotations
 
 import os
+import re
 import time
 
 import numpy as np
@@ -128,7 +129,7 @@ def test_cache_info_and_clean(cache_dir, capsys):
     assert cli.main(["cache", "clean", "--older-than", "2d"]) == 0
     assert "removed 2 maps" in capsys.readouterr().out and len(cache.entries()) == 2
     (cache_dir / "complexity" / "ab").mkdir(parents=True, exist_ok=True)
-    (cache_dir / "complexity" / "ab" / ".abc.npy.x1.tmp").write_bytes(b"left by a kill")
+    (cache_dir / "complexity" / "ab" / ".abc.npz.x1y2z3w4.tmp").write_bytes(b"left by a kill")
     assert cli.main(["cache", "clean"]) == 0
     assert "removed 2 maps" in capsys.readouterr().out and cache.entries() == []
     assert not list(cache_dir.rglob("*.tmp"))
@@ -223,3 +224,68 @@ def test_each_kind_declares_every_kernel_its_gpu_path_runs(monkeypatch):
         options = {"progress": False} if name == "distance_refined" else {}
         kind.gpu(h, **kind.resolve({}), **options)
         assert ran == set(kind.kernels), name
+
+
+def _entry(kind: str, h):
+    return cache.cache_path(kind, cache.cache_key(kind, h, cache.get_kind(kind).resolve({})))
+
+
+def _rewritten(path, change) -> None:
+    """The entry at ``path`` written again as a well-formed file, its arrays passed through ``change``, its key and
+    checksum kept."""
+    with np.load(path) as z:
+        arrays = {name: z[name] if name in ("key", "sha256") else change(z[name]) for name in z.files}
+    with open(path, "wb") as f:
+        np.savez(f, **arrays)
+
+
+@pytest.mark.parametrize("kind,damage,reason", [
+    ("normal", "overwrite", "checksum mismatch|unreadable: BadZipFile: Bad CRC-32"),  # data bytes, header intact
+    ("maxmip", "overwrite", "checksum mismatch|unreadable: BadZipFile: Bad CRC-32"),
+    ("cone", "rewrite", "checksum mismatch"),  # a well-formed file with other data under the stored checksum
+    ("normal", "truncate", "unreadable"),
+    ("complexity", "swap", "it holds another map"),  # another entry's file in its place: a valid map, not this one
+])
+def test_a_damaged_cache_entry_is_rebuilt_with_one_warning(cache_dir, caplog, kind, damage, reason):
+    h, other = smooth_tileable(16, 16, 5), smooth_tileable(16, 16, 6)
+    fresh = cache.generate(kind, h, backend="cpu")
+    cache.cached_generate(kind, h, backend="cpu")
+    path = _entry(kind, h)
+    data = bytearray(path.read_bytes())
+    if damage == "overwrite":
+        data[len(data) // 2: len(data) // 2 + 64] = bytes(range(64))
+    elif damage == "truncate":
+        data = data[: len(data) // 2]
+    elif damage == "swap":
+        cache.cached_generate(kind, other, backend="cpu")
+        data = bytearray(_entry(kind, other).read_bytes())
+    if damage == "rewrite":
+        _rewritten(path, lambda a: a + 1)
+    else:
+        path.write_bytes(bytes(data))
+    caplog.clear()
+    got = cache.cached_generate(kind, h, backend="cpu")
+    same = (all(np.array_equal(a, b) for a, b in zip(got, fresh, strict=True)) if kind == "maxmip"
+            else np.array_equal(got, fresh))
+    assert same, f"served the damaged {kind} map"
+    warnings = [r.getMessage() for r in caplog.records if r.name == "maptools.cache"]
+    assert len(warnings) == 1 and re.match(rf"map cache: {re.escape(str(path))} is damaged \(({reason})", warnings[0]) \
+        and warnings[0].endswith("rebuilding it"), warnings
+    caplog.clear()
+    again = cache.cached_generate(kind, h, backend="cpu")  # rebuilt: a clean hit now
+    assert [r for r in caplog.records if r.name == "maptools.cache"] == []
+    assert np.array_equal(again[0] if kind == "maxmip" else again, fresh[0] if kind == "maxmip" else fresh)
+
+
+@pytest.mark.parametrize("where", ["file", "under a file"])
+@pytest.mark.parametrize("action", ["info", "clean"])
+def test_cache_info_and_clean_refuse_a_cache_path_that_is_not_a_folder(tmp_path, monkeypatch, capsys, where,
+                                                                          action):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    monkeypatch.setenv(cache.CACHE_ENV, str(blocker if where == "file" else blocker / "maps"))
+    assert cli.main(["cache", action]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"maptools: error: map cache {blocker}"), err
+    assert "not a folder; set $WGPUVIEWER_CACHE_DIR to a folder" in err[0], err
+    assert blocker.read_text() == "not a folder"

@@ -137,7 +137,7 @@ def test_cached_generate(tmp_path, monkeypatch):
     monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "cache"))
     h = smooth_tileable(16, 24, 3)
     first = cache.cached_generate("complexity", h, backend="cpu")
-    files = list((tmp_path / "cache").rglob("*.npy"))
+    files = list((tmp_path / "cache").rglob("*.npz"))
     assert len(files) == 1
 
     def boom(*a, **k):
@@ -176,6 +176,15 @@ def test_cli_generate(inputs, tmp_path, capsys):
     (["batch", "IN", "-o", "OUT", "--shard", "3/2"], "--shard"),
     (["batch", "IN", "-o", "OUT", "--kinds", "normal,bogus"], "unknown map kind"),
     (["batch", "IN", "-o", "OUT", "--set", "complexity.gamma"], "--set"),
+    # an option for a kind that is not selected would change nothing: refused, naming it
+    (["batch", "IN", "-o", "OUT", "--kinds", "normal", "--set", "cone.max_ratio=4"],
+     "--set 'cone.max_ratio=4': cone is not among the kinds selected (normal); add it to --kinds or drop the --set"),
+    (["check", "IN", "--kinds", "normal,maxmip", "--set", "complexity.levels=8"],
+     "complexity is not among the kinds selected (normal, maxmip)"),
+    # ... after its value is checked like a selected kind's
+    (["batch", "IN", "-o", "OUT", "--kinds", "normal", "--set", "cone.max_ratio=-5"], "max_ratio"),
+    (["batch", "IN", "-o", "OUT", "--kinds", "cone", "--set", "cone.max_ratio=-5"], "max_ratio"),
+    (["batch", "IN", "-o", "OUT", "--kinds", "normal", "--set", "complexity.bogus=1"], "unknown option(s) bogus"),
 ])
 def test_cli_user_errors_exit_2(inputs, tmp_path, capsys, argv, needle):
     d, _ = inputs

@@ -70,3 +70,38 @@ def test_accuracy_measures_every_ray_search_technique():
     assert list(DEFAULT_SETTINGS) == expected
     assert {name for name, _ in DEFAULT_SETTINGS} == {name for name, t in TECHNIQUES.items() if t.ray_search}
     assert {"quadmax", "quadmax_pom", "auto"} <= {name for name, _ in DEFAULT_SETTINGS}
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(rays=0), "rays = 0; expected 1 to 4194304"),
+    (dict(rays=-1), "rays = -1; expected 1 to 4194304"),
+    (dict(rays=10**12), "rays = 1000000000000; expected 1 to 4194304 (32 bytes a ray"),
+    (dict(rays=64.0), "rays = 64.0; expected a whole number of rays"),
+    (dict(angle_deg=90.0), "angle_deg = 90.0; expected 0 <= angle < 90 degrees"),
+    (dict(angle_deg=-10.0), "angle_deg = -10.0; expected 0 <= angle < 90"),
+    (dict(angle_deg=1e9), "angle_deg = 1000000000.0; expected 0 <= angle < 90"),
+    (dict(angle_deg=float("nan")), "angle_deg = nan"),
+    (dict(angle_deg="30"), "angle_deg = '30'; expected a real number"),
+    (dict(height=np.full((8, 8), 0.5 + 0j)), "height has dtype complex128; expected real numbers"),
+    (dict(height_scale="0.05"), "height_scale = '0.05'; expected a real number"),
+])
+def test_measure_refuses_what_it_cannot_use_in_one_line_before_tracing(kwargs, message, monkeypatch):
+    """Like the CLI's options: an InputError naming the argument and the range, never an IndexError, a MemoryError
+    or NaN statistics; nothing is traced first."""
+    import wgpuviewer.relief.accuracy as accuracy
+
+    monkeypatch.setattr(accuracy, "exact_hit", lambda *a, **k: pytest.fail("traced before the arguments were checked"))
+    args = dict(technique="pom", height=np.full((8, 8), 0.5), angle_deg=30.0, rays=64)
+    args.update(kwargs)
+    with pytest.raises(InputError) as error:
+        measure(**args)
+    text = str(error.value)
+    assert text.startswith("measure: ") and message in text and "\n" not in text, text
+    with pytest.raises(InputError, match="run: "):  # the accuracy table's runs check the same way
+        run({"m": args["height"]}, angles=(args["angle_deg"],), settings=(("pom", {}),), rays=args["rays"],
+            height_scale=args.get("height_scale", 0.05))
+
+
+def test_measure_at_its_largest_angle_and_ray_counts_gives_numbers(gpu):
+    a = measure("pom", np.full((8, 8), 0.5), 89.9, rays=1)
+    assert a.rays == 1 and np.isfinite(a.fetches_mean)

@@ -168,3 +168,12 @@ def test_non_finite_hits_are_flagged_capped(gpu):
     got = probe("pom", height_map("bumps", (16, 16)), np.full((3, 2), 0.5), [[0, 0, 0], [0, 0, 1], [1, 0, 0]], 0.05)
     bad = ~np.isfinite(got.uv).all(axis=1) | ~np.isfinite(got.depth)
     assert (got.capped | ~bad).all() and not got.capped[1]
+
+
+@pytest.mark.parametrize("field, value", [("uv", np.array([[0.5 + 1j, 0.5]])), ("uv", np.array([["0.5", "0.5"]])),
+                                          ("view", np.array([[0.1, 0.1, 1.0 + 0j]])), ("height_scale", True)])
+def test_probe_refuses_inputs_that_are_not_real_numbers(field, value):
+    args = {"uv": np.array([[0.5, 0.5]]), "view": np.array([[0.1, 0.1, 1.0]]), "height_scale": 0.05}
+    args[field] = value
+    with pytest.raises(InputError, match=f"probe: {field}"):
+        probe("pom", np.zeros((4, 4), np.float32), args["uv"], args["view"], args["height_scale"])

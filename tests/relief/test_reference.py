@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
+from wgpuviewer.core.errors import InputError
 from wgpuviewer.relief.reference import (
     Hit,
     exact_hit,
@@ -490,3 +493,29 @@ def test_view_dir_from_angles():
     assert many.shape == (7, 3)
     np.testing.assert_allclose(np.linalg.norm(many, axis=1), 1.0, atol=1e-15)
     np.testing.assert_allclose(many[:, 0], many[:, 1], atol=1e-15)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(uv=np.array([0.5 + 1j, 0.5])), "uv has dtype complex128; expected real numbers"),
+    (dict(uv=["0.5", "0.5"]), "uv has dtype <U3; expected real numbers"),
+    (dict(view_dir=np.array([0, 0, 1], object)), "view_dir has dtype object"),
+    (dict(view_dir=[True, False, True]), "view_dir has dtype bool"),
+    (dict(depth=np.zeros((4, 4), complex)), "depth has dtype complex128"),
+    (dict(height_scale="0.1"), "height_scale = '0.1'; expected a real number"),
+    (dict(height_scale=0.1 + 0j), "height_scale = (0.1+0j); expected a real number"),
+])
+def test_real_numbers_only(kwargs, message):
+    """Complex values would lose their imaginary part and strings would be parsed: both are refused, naming the
+    argument (an InputError, which the CLIs report as one line)."""
+    args = dict(depth=np.zeros((4, 4)), uv=[0.5, 0.5], view_dir=[0, 0, 1.0], height_scale=0.1)
+    args.update(kwargs)
+    with pytest.raises(InputError, match=re.escape(message)):
+        exact_hit(**args)
+
+
+def test_integer_and_other_floating_dtypes_are_real_numbers():
+    hit = exact_hit(np.zeros((4, 4), np.uint8), np.array([[0, 0]], np.int64), np.array([0, 0, 1], np.float32),
+                    np.float32(0.1))
+    assert hit.valid[0] and hit.t[0] == 0.0
+    with pytest.raises(InputError, match="theta_deg has dtype <U2"):
+        view_dir_from_angles("30", 0.0)

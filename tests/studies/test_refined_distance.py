@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from maptools.cache import cached_generate
+from wgpuviewer.bench.run import REAL_MAPS
 from wgpuviewer.relief.accuracy import random_rays
 from wgpuviewer.relief.maps import DISTANCE_SLICES
 from wgpuviewer.relief.probe import probe
@@ -15,7 +16,7 @@ from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFIN
 from wgpuviewer.studies.refined_distance.baseline import plain_before
 from wgpuviewer.studies.refined_distance.run import SUITES, VARIANTS, run
 from wgpuviewer.studies.refined_distance.tracer import trace
-from wgpuviewer.textures import builtin_height
+from wgpuviewer.textures import BUILTINS, builtin_height
 
 
 @pytest.mark.parametrize("name", ["bricks", "wall"])
@@ -67,6 +68,21 @@ def test_cli_rejects_bad_options(tmp_path, capsys):
     for argv in (["--angles", "90"], ["--angles", "a"], ["--heightmaps", "nope"], ["--heightmaps", ","]):
         assert main(["refined-distance", "--out", str(tmp_path), *argv]) == 2
         assert "Traceback" not in capsys.readouterr().err
+
+
+def test_an_unknown_height_map_is_refused_before_the_folder_or_the_gpu(tmp_path, monkeypatch, capsys):
+    from wgpuviewer.cli import main
+    from wgpuviewer.core import gpu
+
+    def no_gpu(*args, **kwargs):
+        raise AssertionError("the GPU was started")
+
+    monkeypatch.setattr(gpu, "get_gpu", no_gpu)
+    out = tmp_path / "new"
+    assert main(["refined-distance", "--out", str(out), "--suite", "smoke", "--heightmaps", "bricks,bogus"]) == 2
+    assert capsys.readouterr().err.strip() == ("wgpuviewer: error: --heightmaps: unknown height map 'bogus'; "
+                                               "expected some of " + ", ".join((*BUILTINS, *REAL_MAPS)))
+    assert not out.exists()
 
 
 @pytest.mark.parametrize("name, size", [("bricks", (40, 40)), ("wall", (40, 24)), ("spike", (17, 33)), ("flat1", (1, 1))])

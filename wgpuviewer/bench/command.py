@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from wgpuviewer.core.cli import comma_list, comma_numbers, parse_size
-from wgpuviewer.core.io import output_dir
+from wgpuviewer.core.errors import UserError
 from wgpuviewer.harness.study import add_measurement_options
 
 
@@ -28,8 +28,9 @@ class Bench:
         parser.add_argument("--from-csv", nargs="+", metavar="CSV",
                             help="measure nothing: write report.md and plots from these results.csv files into --out")
 
-    def run(self, args) -> int:
-        from .run import rereport, resolve_options, run
+    def options(self, args) -> dict:
+        """What ``run`` takes: the run's options (each checked) or the results files to report again."""
+        from .run import resolve_options
 
         def size(text, option):
             return parse_size(text, option) if text else None
@@ -40,11 +41,20 @@ class Bench:
             techniques=comma_list(args.techniques, "--techniques"),
             angles=comma_numbers(args.angles, "--angles", "0,45,80"), frames=args.frames, backend=args.backend,
             command=args.command_line, simd_tile=size(args.simd_tile, "--simd-tile"))
-        out = output_dir(args.out, "--out")  # before a long run, not after it
-        if args.from_csv:
-            rereport([Path(p) for p in args.from_csv], out, args.command_line)
+        from_csv = [Path(p) for p in args.from_csv or ()]
+        for path in from_csv:
+            if not path.is_file():
+                raise UserError(f"--from-csv {path}: no such file; give the results.csv of earlier runs")
+        return {"options": options, "from_csv": from_csv, "progress": not args.quiet}
+
+    def run(self, checked: dict, out: Path) -> int:
+        from .run import rereport, run
+
+        options = checked["options"]
+        if checked["from_csv"]:
+            rereport(checked["from_csv"], out, options.command)
         else:
-            run(options, out, progress=not args.quiet)
+            run(options, out, progress=checked["progress"])
             for note in options.notes:
                 print(f"note: {note}", file=sys.stderr)
         print(out / "report.md")

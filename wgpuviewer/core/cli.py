@@ -4,7 +4,8 @@ loads, warnings as one line each, argparse errors as one line, option values che
 
 Exit codes: 0 success, 1 a check or batch job failed (the commands return it), 2 a user error (``UserError`` or
 ``InputError``: one line naming the thing and the fix), 3 an internal error (a bug: a one-line summary, and the
-traceback saved to a file whose path is printed), 130 interrupted.
+traceback saved to a file whose path is printed), 130 interrupted (SIGINT, Ctrl-C), 143 terminated (SIGTERM: it
+unwinds like SIGINT, so no temp file is left behind).
 
 This module imports only the standard library at import time, so a CLI can call ``prepare_process`` before
 wgpu or OpenCV load.
@@ -17,7 +18,7 @@ import contextlib
 import logging
 import os
 import shlex
-import stat
+import signal
 import sys
 import tempfile
 import threading
@@ -26,33 +27,11 @@ import traceback
 from collections.abc import Callable
 from pathlib import Path
 
+from .env import check_environment, prepare_driver_environment
 from .errors import InputError, UserError
 
 #: Loggers whose warnings the CLIs print as ``PROG: warning: MESSAGE``.
 WARNING_LOGGERS = ("wgpuviewer", "maptools")
-
-
-def _runtime_dir_ok(path: str | None) -> bool:
-    """What Mesa's window-system code accepts as $XDG_RUNTIME_DIR: an absolute folder of ours, mode 0700."""
-    if not path or not os.path.isabs(path):
-        return False
-    try:
-        info = os.stat(path)
-    except OSError:
-        return False
-    return stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid() and stat.S_IMODE(info.st_mode) == 0o700
-
-
-def private_runtime_dir() -> str:
-    """A folder of this user's only (mode 0700) in the temp dir: ``wgpuviewer-runtime-UID``, or a fresh one."""
-    path = os.path.join(tempfile.gettempdir(), f"wgpuviewer-runtime-{os.getuid()}")
-    try:
-        os.mkdir(path, 0o700)
-    except FileExistsError:
-        pass
-    except OSError:
-        return tempfile.mkdtemp(prefix="wgpuviewer-runtime-")
-    return path if _runtime_dir_ok(path) else tempfile.mkdtemp(prefix="wgpuviewer-runtime-")
 
 
 def prepare_process(prog: str) -> None:
@@ -65,8 +44,7 @@ def prepare_process(prog: str) -> None:
       where the build can;
     - warnings of the project's loggers print as one line ``PROG: warning: ...`` on stderr.
     """
-    if os.name == "posix" and not _runtime_dir_ok(os.environ.get("XDG_RUNTIME_DIR")):
-        os.environ["XDG_RUNTIME_DIR"] = private_runtime_dir()
+    prepare_driver_environment()
     os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
     os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")
     cv2 = sys.modules.get("cv2")
@@ -197,17 +175,47 @@ def save_traceback(prog: str, error: BaseException) -> Path | None:
 
 
 def run_command(prog: str, command: Callable[[], int]) -> int:
-    """Run a CLI command and turn what it raises into the exit codes of the module docstring."""
+    """Run a CLI command, after checking the environment variables (``core.env``: every command refuses what any
+    refuses), and turn what it raises into the exit codes of the module docstring."""
+    with sigterm_unwinds():
+        try:
+            check_environment()
+            return command()
+        except (UserError, InputError) as error:
+            print(f"{prog}: error: {error}", file=sys.stderr)
+            return 2
+        except Terminated:
+            print(f"{prog}: terminated", file=sys.stderr)
+            return 143
+        except KeyboardInterrupt:
+            print(f"{prog}: interrupted", file=sys.stderr)
+            return 130
+        except Exception as error:  # noqa: BLE001 - the one place that reports bugs
+            return report_internal_error(prog, error)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM during a command. A KeyboardInterrupt, so everything that unwinds for Ctrl-C unwinds for it too
+    (atomic writes remove their temps, worker pools shut down); ``run_command`` exits 143 for it."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated
+
+
+@contextlib.contextmanager
+def sigterm_unwinds():
+    """While inside, SIGTERM raises ``Terminated`` in the main thread instead of ending the process where it stands
+    (Python's default, which runs no ``finally`` and leaves temp files behind); the previous handler comes back
+    after. Only the main thread may set handlers: from another thread this changes nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
     try:
-        return command()
-    except (UserError, InputError) as error:
-        print(f"{prog}: error: {error}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
-        return 130
-    except Exception as error:  # noqa: BLE001 - the one place that reports bugs
-        return report_internal_error(prog, error)
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
 def report_internal_error(prog: str, error: BaseException) -> int:

@@ -1,12 +1,16 @@
 """GPU acquisition: pick an adapter for a backend, create (and cache) one device per backend.
 
 `auto` prefers a hardware adapter (discrete, then integrated) and falls back to a software one
-(Mesa lavapipe/llvmpipe, WARP, SwiftShader) with a one-line notice on stderr.
+(Mesa lavapipe/llvmpipe, WARP, SwiftShader) with a one-line notice on stderr. The first adapter request prepares
+what the drivers read from the environment (``prepare_driver_environment``), for the CLIs and the Python API alike.
+
+GPU memory: every texture and buffer the project creates goes through ``allocating``, so an adapter out of memory
+is a ``UserError`` naming what was being made, the bytes it needed and the fix, never an internal error.
 """
 
 from __future__ import annotations
 
-import os
+import contextlib
 import sys
 import threading
 from dataclasses import dataclass, field
@@ -15,12 +19,13 @@ import cv2
 import numpy as np
 import wgpu
 
+from . import env
 from .errors import NoAdapterError, UserError
 
 #: CLI name -> wgpu backend_type as reported in ``adapter.info``.
 BACKENDS = {"vulkan": "Vulkan", "metal": "Metal", "dx12": "D3D12", "gl": "OpenGL"}
 BACKEND_CHOICES = ("auto", *BACKENDS)
-BACKEND_ENV = "WGPUVIEWER_BACKEND"
+BACKEND_ENV = env.BACKEND.name
 
 #: Optional features we use when the adapter has them.
 WANTED_FEATURES = ("float32-filterable", "timestamp-query", "shader-f64")
@@ -34,15 +39,17 @@ NO_ADAPTER_FIX = (
 
 
 def resolve_backend(backend: str | None) -> str:
-    """CLI/env backend name -> one of BACKEND_CHOICES (argument wins over the environment)."""
-    name = (backend or os.environ.get(BACKEND_ENV) or "auto").strip().lower()
+    """CLI/env backend name -> one of BACKEND_CHOICES (argument wins over the environment, parsed by core.env)."""
+    if not backend:
+        return env.BACKEND.value()
+    name = backend.strip().lower()
     if name not in BACKEND_CHOICES:
-        source = "--backend" if backend else BACKEND_ENV
-        raise UserError(f"{source}: unknown backend {name!r}; expected one of {', '.join(BACKEND_CHOICES)}")
+        raise UserError(f"--backend: unknown backend {name!r}; expected one of {', '.join(BACKEND_CHOICES)}")
     return name
 
 
 def list_adapters() -> list[wgpu.GPUAdapter]:
+    env.prepare_driver_environment()  # the API's first GPU use is as quiet as the CLIs'
     return list(wgpu.gpu.enumerate_adapters_sync())
 
 
@@ -175,22 +182,70 @@ def to_texel_data(data: np.ndarray, fmt: str) -> np.ndarray:
     return out
 
 
+def format_bytes(n: float) -> str:
+    """A byte count for messages: '512 B', '3.0 MiB', '4.0 GiB'."""
+    for unit in ("B", "KiB", "MiB", "GiB"):
+        if n < 1024:
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n:.1f} TiB"
+
+
+def _out_of_memory(error: Exception) -> bool:
+    """Whether wgpu reports the adapter out of memory: GPUOutOfMemoryError, or (wgpu-native on Vulkan) a
+    validation error 'Not enough memory left' raised by the creating call."""
+    return isinstance(error, wgpu.GPUOutOfMemoryError) or (
+        isinstance(error, wgpu.GPUValidationError) and "memory" in str(error).lower())
+
+
+@contextlib.contextmanager
+def allocating(gpu: Gpu, what: str, nbytes: int, fix: str):
+    """Create GPU resources for ``what`` (``nbytes`` of GPU memory) inside: the adapter running out of memory is a
+    UserError ``WHAT needs N GiB of GPU memory, more than ADAPTER could allocate; FIX``; other errors pass."""
+    try:
+        yield
+    except (wgpu.GPUOutOfMemoryError, wgpu.GPUValidationError) as error:
+        if not _out_of_memory(error):
+            raise
+        raise UserError(f"{what} needs {format_bytes(nbytes)} of GPU memory, more than {gpu.summary} could "
+                        f"allocate; {fix}") from None
+
+
+def texel_bytes(fmt: str) -> int:
+    """Bytes per texel of a format ``create_texture`` uploads."""
+    dtype, channels = _TEXEL[fmt]
+    return np.dtype(dtype).itemsize * channels
+
+
+def check_texture_size(gpu: Gpu, w: int, h: int, what: str, fix: str) -> None:
+    """A UserError when a w x h 2D texture exceeds the adapter's limit per side (checked before any data is made)."""
+    limit = gpu.device.limits["max-texture-dimension-2d"]
+    if max(w, h) > limit:
+        raise UserError(f"{what}: texture of {w}x{h} exceeds this adapter's limit of {limit} texels per side; {fix}")
+
+
+#: What a user can do about a texture too large for the adapter.
+SMALLER_TEXTURE = "use a smaller texture"
+
+
 def create_texture(gpu: Gpu, levels, fmt: str, label: str) -> wgpu.GPUTexture:
     """A sampled 2D texture from a mip chain (``levels[0]`` is the base level; a list, or ``mip_chain``'s lazy
     chain). Each level is converted and uploaded in row bands, so no full-size texel copy is ever made: peak
-    memory is the caller's base level plus the next level (a quarter of it)."""
+    memory is the caller's base level plus the next level (a quarter of it). Too large for the adapter (limit
+    per side, memory): a UserError naming ``label``."""
     base = levels[0]
     h, w = base.shape[:2]
-    limit = gpu.adapter.limits["max-texture-dimension-2d"]
-    if max(w, h) > limit:
-        raise UserError(f"{label}: texture of {w}x{h} exceeds this adapter's limit of {limit} texels per side")
-    texture = gpu.device.create_texture(
-        label=label,
-        size=(w, h, 1),
-        format=fmt,
-        usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
-        mip_level_count=len(levels),
-    )
+    check_texture_size(gpu, w, h, label, SMALLER_TEXTURE)
+    count = len(levels)
+    nbytes = sum(max(w >> m, 1) * max(h >> m, 1) for m in range(count)) * texel_bytes(fmt)
+    with allocating(gpu, label, nbytes, SMALLER_TEXTURE):
+        texture = gpu.device.create_texture(
+            label=label,
+            size=(w, h, 1),
+            format=fmt,
+            usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
+            mip_level_count=count,
+        )
     dtype, channels = _TEXEL[fmt]
     for level, data in enumerate(levels):
         lh, lw = data.shape[:2]

@@ -17,13 +17,22 @@ such a file as float32 (H, W) in [0, 1], with one channel rule everywhere:
 Non-finite values (float files) follow ``nan_policy``: ``error`` (refuse), ``zero``, or ``nearest`` (the value of
 the nearest finite texel); how many were replaced is logged as a warning. Every problem is a one-line
 ``FileError`` (a ``UserError``) naming the file; its ``reason`` lets a caller name the key the file came from.
+A broken symbolic link or a link loop is named as such (``link_problem``), not as a missing or unreadable file.
+
+The native decoders (libpng, libjpeg) print their complaints on the process's stderr themselves; those lines are
+captured around each decode (``_native_stderr``) and end up in our one line: the reason of a decode that failed,
+or a warning naming the file when the decoder recovered (a damaged JPEG decodes with garbage in it).
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import logging
 import os
 import struct
+import sys
+import tempfile
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -158,17 +167,31 @@ def _check_tail(path: Path, f, size: int, fmt: str) -> None:
         raise FileError(path, f"truncated JPEG (no end-of-image marker); {_REWRITE}")
 
 
+def link_problem(path) -> str | None:
+    """Why the symbolic link ``path`` leads to no file: a broken link (its target does not exist) or a link loop,
+    with the fix; None when ``path`` is not such a link."""
+    try:
+        os.stat(path)
+    except FileNotFoundError:
+        if os.path.islink(path):
+            return f"broken link to {os.readlink(path)} (the target does not exist); fix or remove the link"
+    except OSError as e:
+        if e.errno == errno.ELOOP:
+            return "symbolic link loop (the link leads back to itself); fix or remove the link"
+    return None
+
+
 def read_header(path) -> Header:
     """Format and size of an image or ``.npy`` file from its header, every limit checked (module docstring)."""
     path = Path(path)
     try:
         f = open(path, "rb")  # noqa: SIM115 - closed below
     except FileNotFoundError:
-        raise FileError(path, "file not found") from None
+        raise FileError(path, link_problem(path) or "file not found") from None
     except IsADirectoryError:
         raise FileError(path, f"is a directory; expected an image or .npy file ({_FORMATS})") from None
     except OSError as e:
-        raise FileError(path, f"cannot read ({e.strerror or e})") from None
+        raise FileError(path, link_problem(path) or f"cannot read ({e.strerror or e})") from None
     with f:
         if not os.path.isfile(path):
             raise FileError(path, f"not a regular file; expected an image or .npy file ({_FORMATS})")
@@ -203,6 +226,72 @@ def read_header(path) -> Header:
         return header
 
 
+_NATIVE_STDERR_LOCK = threading.Lock()
+
+
+def _writes_to_fd2(stream) -> bool:
+    try:
+        return stream.fileno() == 2
+    except (AttributeError, OSError, ValueError):  # pytest's capture, a closed or replaced stream
+        return False
+
+
+class _HeldStderr:
+    """Stands in for ``sys.stderr`` while a decode holds file descriptor 2: other threads' writes wait for the
+    decode to end and then go to the stream that was there, so none is taken for the decoder's. Whoever keeps a
+    reference past the decode writes straight through."""
+
+    def __init__(self, stream, released: threading.Event):
+        self._stream, self._released, self._owner = stream, released, threading.get_ident()
+
+    def write(self, text):
+        if threading.get_ident() != self._owner:
+            self._released.wait()
+        return self._stream.write(text)
+
+    def __getattr__(self, name):  # flush, fileno, isatty, encoding, ...
+        return getattr(self._stream, name)
+
+
+@contextlib.contextmanager
+def _native_stderr(messages: list[str]):
+    """Appends to ``messages`` the lines native code prints on file descriptor 2 during the block, instead of
+    letting them reach the terminal ahead of our own line. One block at a time holds the descriptor; Python's
+    stderr is held meanwhile (``_HeldStderr``), and terminal redraws written to the descriptor (a progress bar:
+    lines with CR or escape codes) are passed on."""
+    with _NATIVE_STDERR_LOCK, tempfile.TemporaryFile() as sink:
+        python_stderr = sys.stderr
+        with contextlib.suppress(Exception):
+            python_stderr.flush()
+        try:
+            saved = os.dup(2)
+        except OSError:  # no descriptor 2 (a detached process): nothing to take
+            yield
+            return
+        released = threading.Event()
+        held = _HeldStderr(python_stderr, released) if _writes_to_fd2(python_stderr) else None
+        if held is not None:
+            sys.stderr = held
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            released.set()
+            if held is not None and sys.stderr is held:
+                sys.stderr = python_stderr
+            sink.seek(0)
+            lines = sink.read().decode(errors="replace").split("\n")
+            for i, line in enumerate(lines):
+                if "\r" in line or "\x1b" in line:
+                    with contextlib.suppress(Exception):
+                        python_stderr.write(line + ("\n" if i < len(lines) - 1 else ""))
+                        python_stderr.flush()
+                elif line.strip():
+                    messages.append(line.strip())
+
+
 def _decode(path: Path) -> tuple[np.ndarray, bool]:
     """Raw array of a file and whether its channels are in RGB(A) order (.npy) rather than BGR(A) (OpenCV).
     The header is checked first: nothing over the limits is ever loaded."""
@@ -213,10 +302,18 @@ def _decode(path: Path) -> tuple[np.ndarray, bool]:
         except Exception as e:  # noqa: BLE001 - any parse failure is the file's fault
             raise FileError(path, f"cannot read .npy array ({type(e).__name__}: {e}); save it with numpy.save") \
                 from None
-    # imdecode instead of imread: the same decoders, but non-ASCII paths work everywhere.
-    data = cv2.imdecode(np.fromfile(path, np.uint8), cv2.IMREAD_UNCHANGED)
+    encoded = np.fromfile(path, np.uint8)
+    said: list[str] = []
+    with _native_stderr(said):
+        # imdecode instead of imread: the same decoders, but non-ASCII paths work everywhere.
+        data = cv2.imdecode(encoded, cv2.IMREAD_UNCHANGED)
+    decoder = f"; the decoder said: {'; '.join(said)}" if said else ""
     if data is None:
-        raise FileError(path, f"cannot decode image (corrupt or unsupported {header.format}); use {_FORMATS}")
+        raise FileError(path, f"cannot decode image (corrupt or unsupported {header.format}{decoder}); "
+                              f"write or download it again, or use {_FORMATS}")
+    if said:
+        log.warning(f"{path}: decoded, but the {header.format} decoder said: {'; '.join(said)}; if the image looks "
+                    "damaged, write or download it again")
     return data, False
 
 

@@ -4,10 +4,13 @@ of bench and the studies too: ``wgpuviewer.harness.table``).
 
 Every way a write can fail that the user can fix (the path is a folder, the disk is full, the folder is read-only
 or not ours, a parent is a file) is a one-line ``UserError`` naming the path and the fix; nothing is left behind.
-``output_dir`` checks an output folder up front (creates it, proves it writable).
+``output_dir`` checks an output folder up front (not empty, not an existing file, creatable and writable) and
+creates it; when it cannot, it leaves nothing behind.
 
-While it is written, a temp file is locked (``flock``) by its writer; ``remove_stale_temps`` removes only the
-temps no live process holds, so concurrent writers into one folder never delete each other's work.
+The temp file of ``NAME`` is ``.NAME.XXXXXXXX.tmp`` (``TEMP_NAME``: eight characters of ``tempfile.mkstemp``'s
+alphabet). While it is written it is locked (``flock``) by its writer; ``remove_stale_temps`` and
+``remove_abandoned_temps`` remove only files of exactly that pattern that no live process holds, so concurrent
+writers into one folder never delete each other's work, and a user's own ``*.tmp`` files are never touched.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import contextlib
 import errno
 import glob
 import os
+import re
 import tempfile
 import time
 from pathlib import Path
@@ -27,6 +31,9 @@ try:
 except ImportError:  # Windows: an open file cannot be removed there anyway
     fcntl = None
 
+#: The temp files ``atomic_open`` makes: ``.`` + the target's name + ``.`` + mkstemp's eight random characters +
+#: ``.tmp`` (``_locked_temp``); the only files the stale-temp cleaners remove.
+TEMP_NAME = re.compile(r"\.(?P<target>.+)\.[a-z0-9_]{8}\.tmp")
 #: Without flock (Windows), temps older than this are taken as abandoned.
 UNLOCKED_TEMP_AGE = 24 * 3600.0
 
@@ -156,27 +163,56 @@ def remove_stale_temps(path) -> int:
     """Remove temp files of ``path`` that killed writers left behind; temps of live writers (other processes or
     threads writing ``path`` now) stay. Returns how many were removed."""
     path = Path(path)
-    return sum(_remove_if_abandoned(tmp) for tmp in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"))
+    return sum(_remove_if_abandoned(tmp) for tmp in path.parent.glob(f".{glob.escape(path.name)}.*.tmp")
+               if _is_temp(tmp, path.name))
 
 
 def remove_abandoned_temps(folder) -> int:
-    """``remove_stale_temps`` for every output in ``folder``: the temps no live writer holds."""
-    return sum(_remove_if_abandoned(tmp) for tmp in Path(folder).glob(".*.tmp"))
+    """``remove_stale_temps`` for every output in ``folder`` (not its subfolders): the temps no live writer holds.
+    Returns how many were removed."""
+    return sum(_remove_if_abandoned(tmp) for tmp in Path(folder).glob(".*.tmp") if _is_temp(tmp))
+
+
+def _is_temp(path: Path, target: str | None = None) -> bool:
+    """Whether ``path`` is named as ``atomic_open``'s temp (of ``target``, when given) and is a plain file."""
+    match = TEMP_NAME.fullmatch(path.name)
+    return bool(match) and (target is None or match["target"] == target) and path.is_file() and not path.is_symlink()
 
 
 def output_dir(path, option: str = "") -> Path:
-    """Make sure ``path`` is a folder this process can write to (creating it); a one-line UserError otherwise."""
-    path = Path(path)
-    what = f"{option} {path}" if option else str(path)
-    if path.exists() and not path.is_dir():
+    """Make sure ``path`` is a folder this process can write to, creating it (and its missing parents); a one-line
+    UserError naming ``option`` and the path otherwise: an empty path, an existing entry that is not a folder (a
+    file, a dangling link), or a folder that cannot be created or written, in which case the folders made for it
+    are removed again."""
+    text = os.fspath(path)
+    shown = text if text.strip() else repr(text)
+    what = f"{option} {shown}" if option else shown
+    if not text.strip():
+        raise UserError(f"{what}: empty; give a folder path")
+    path = Path(text)
+    if os.path.lexists(path) and not path.is_dir():
         raise UserError(f"{what}: exists and is not a folder; give a folder path")
+    created: list[Path] = []
     try:
-        path.mkdir(parents=True, exist_ok=True)
+        for folder in _missing_folders(path):
+            folder.mkdir()
+            created.append(folder)
         fd, probe = tempfile.mkstemp(prefix=".write-test.", suffix=".tmp", dir=path)
         os.close(fd)
         os.unlink(probe)
     except OSError as error:
+        for folder in reversed(created):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
         raise UserError(f"{what}: cannot write there ({error.strerror or error}); "
                         f"{_FIXES.get(error.errno, 'choose another folder')}") from None
     return path
 
+
+def _missing_folders(path: Path) -> list[Path]:
+    """``path`` and those of its parents that do not exist, outermost first."""
+    missing = []
+    while not os.path.lexists(path) and path.parent != path:
+        missing.append(path)
+        path = path.parent
+    return missing[::-1]

@@ -8,6 +8,8 @@ the benchmark, so every number about a technique's error and cost is computed on
 from __future__ import annotations
 
 import datetime
+import math
+import numbers
 import time
 from dataclasses import dataclass
 
@@ -16,8 +18,8 @@ import numpy as np
 from wgpuviewer.core.errors import InputError
 
 from .probe import probe
-from .reference import Hit, exact_hit, uv_error_texels, view_dir_from_angles
-from .techniques import TECHNIQUES
+from .reference import Hit, exact_hit, real_array, real_number, uv_error_texels, view_dir_from_angles
+from .techniques import TECHNIQUES, get_technique, resolve_params
 
 
 @dataclass
@@ -62,6 +64,43 @@ def simd_tile_cost(fetches: np.ndarray, tile: tuple[int, int] = SIMD_TILE, cover
     return float(used.mean()) if used.size else float("nan")
 
 
+#: Most rays one measurement traces: the probe's ray and hit buffers take 32 bytes a ray each, and 2^22 rays fill
+#: WebGPU's default 128 MiB storage buffer (the float64 reference needs a few hundred bytes a ray besides).
+MAX_RAYS = 1 << 22
+#: View angles are degrees from the normal in [0, MAX_ANGLE): at 90 degrees (grazing) no ray descends into the
+#: relief, and every error statistic would be NaN.
+MAX_ANGLE = 90.0
+
+
+def check_rays(rays, where: str = "measure") -> int:
+    """``rays`` when it is a whole number from 1 to MAX_RAYS; an InputError naming it otherwise."""
+    if isinstance(rays, bool) or not isinstance(rays, numbers.Integral):
+        raise InputError(f"{where}: rays = {rays!r}; expected a whole number of rays, 1 to {MAX_RAYS}")
+    if not 1 <= rays <= MAX_RAYS:
+        raise InputError(f"{where}: rays = {rays}; expected 1 to {MAX_RAYS} (32 bytes a ray in the probe's ray and "
+                         f"hit buffers, within WebGPU's default 128 MiB storage buffer); measure more seeds instead")
+    return int(rays)
+
+
+def check_angle(angle, where: str = "measure") -> float:
+    """``angle`` (degrees from the normal) when it is a real number in [0, MAX_ANGLE); an InputError otherwise."""
+    a = real_number(angle, f"{where}: angle_deg")
+    if not (math.isfinite(a) and 0.0 <= a < MAX_ANGLE):
+        raise InputError(f"{where}: angle_deg = {angle!r}; expected 0 <= angle < {MAX_ANGLE:g} degrees from the "
+                         "normal (at 90, grazing, no ray enters the relief)")
+    return a
+
+
+def _checked(where: str, technique: str, params: dict, height, height_scale, rays) -> tuple[np.ndarray, int]:
+    """The arguments measure and run share, checked before any tracing: (height as float64, rays)."""
+    resolve_params(get_technique(technique), params)
+    height = real_array(height, f"{where}: height")
+    scale = real_number(height_scale, f"{where}: height_scale")
+    if not (math.isfinite(scale) and scale >= 0.0):
+        raise InputError(f"{where}: height_scale = {height_scale!r}; expected a finite relief depth >= 0 UV units")
+    return height, check_rays(rays, where)
+
+
 def random_rays(n: int, angle_deg: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """``n`` entry points uniform over the texture, view directions at ``angle_deg`` from the normal
     with uniformly random azimuth."""
@@ -75,8 +114,10 @@ def measure(
     technique: str, height: np.ndarray, angle_deg: float, height_scale: float = 0.05,
     rays: int = 4096, seed: int = 0, backend: str | None = None, **params,
 ) -> Accuracy:
-    """Trace ``rays`` random rays at ``angle_deg`` with the GPU probe and the float64 reference."""
-    height = np.asarray(height, np.float64)
+    """Trace ``rays`` random rays (1 to MAX_RAYS) at ``angle_deg`` (degrees from the normal, 0 <= angle < 90) with the
+    GPU probe and the float64 reference. Arguments it cannot use raise InputError before anything is traced."""
+    height, rays = _checked("measure", technique, params, height, height_scale, rays)
+    angle_deg = check_angle(angle_deg)
     uv, view = random_rays(rays, angle_deg, seed)
     ref = exact_hit(1.0 - height, uv, view, height_scale)
     return _scored(technique, params, height, angle_deg, uv, view, ref, height_scale, backend)
@@ -126,11 +167,16 @@ class Run:
 
 def run(heightmaps: dict, angles=DEFAULT_ANGLES, settings=DEFAULT_SETTINGS, height_scale=0.05, rays=4096,
         backend=None, progress=None) -> Run:
-    """Measure each setting at each angle on each height map (``progress()`` after each measurement)."""
+    """Measure each setting at each angle on each height map (``progress()`` after each measurement); arguments are
+    checked as ``measure`` checks them, all before anything is traced."""
+    angles = tuple(check_angle(angle, "run") for angle in angles)
+    maps = {}
+    for name, height in heightmaps.items():
+        for technique, params in settings:
+            maps[name], rays = _checked("run", technique, params, height, height_scale, rays)
     start = time.perf_counter()
     results = {}
-    for name, height in heightmaps.items():
-        height = np.asarray(height, np.float64)
+    for name, height in maps.items():
         for angle in angles:
             uv, view = random_rays(rays, angle)
             ref = exact_hit(1.0 - height, uv, view, height_scale)

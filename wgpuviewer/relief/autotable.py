@@ -33,9 +33,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from maptools.cache import cache_key, cache_path
+from maptools.cache import cache_key, cached
 from wgpuviewer.core.gpu import Gpu, create_texture
-from wgpuviewer.core.io import atomic_open
 from wgpuviewer.core.wgsl import compose
 
 from .reference import exact_hit, uv_error_texels, view_dir_from_angles
@@ -172,18 +171,9 @@ def measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndarr
                "code": candidates_code(),
                "angles": [float(a) for a in edge_angles()], "error_rays": ERROR_RAYS, "tiles": TILES, "tile": list(TILE),
                "spacing": TILE_SPACING, "seed": SEED, "version": VERSION}
-    path = cache_path("auto_table", cache_key("auto_table", d, options))
-    if path.is_file():
-        try:
-            table = np.load(path, allow_pickle=False)
-            if table.shape == (len(AUTO_CANDIDATES) + len(SCALED), len(edge_angles()), len(FIELDS)):
-                return table
-        except (OSError, ValueError):  # a damaged cache entry is measured again
-            pass
-    table = _measure(d.astype(np.float64), height_scale, probe)
-    with atomic_open(path) as f:
-        np.save(f, table)
-    return table
+    # the cache checks each entry's key and checksum: a damaged one is measured again, with a warning
+    return cached("auto_table", cache_key("auto_table", d, options),
+                  lambda: _measure(d.astype(np.float64), height_scale, probe))
 
 
 def choose(table: np.ndarray) -> np.ndarray:

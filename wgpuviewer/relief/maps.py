@@ -6,6 +6,10 @@ and the maps maptools generates), which this module builds from a depth map. A s
 type (``shaders.interface`` generates the binding line: binding 2 + the slot's position in ``MAP_SLOTS``) and its
 bind-group layout entry. Derived maps come from maptools' registry and disk cache (content hash + options),
 never from a private copy.
+
+A derived slot's ``check`` refuses a height map too large for the map on this adapter from its size alone (the
+renderer calls it with a file's header size before loading or generating anything; ``build`` calls it too), naming
+what exceeds which limit and the size of height map that fits: a scene has no map options to change.
 """
 
 from __future__ import annotations
@@ -16,9 +20,14 @@ from dataclasses import dataclass
 import numpy as np
 import wgpu
 
+from maptools import cone as cone_kind
+from maptools import distance as distance_kind
+from maptools import refined as refined_kind
 from maptools.cache import cached_generate
+from maptools.cpu import level_sizes
+from wgpuviewer.core.compute import compute_for
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
+from wgpuviewer.core.gpu import Gpu, allocating, check_texture_size, create_texture, mip_chain
 
 from . import autotable
 from .techniques import CONE_FILTER, CONE_MAX_RATIO, REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
@@ -32,6 +41,9 @@ class MapSlot:
     #: Height-derived slots: (gpu, depth, height_scale, label) -> texture. None: a material texture (albedo, normal).
     build: Callable[[Gpu, np.ndarray, float, str], wgpu.GPUTexture] | None
     doc: str  # the generated binding line's comment
+    #: (gpu, width, height) of the height map -> None, or a UserError when the map cannot be built from a map of
+    #: that size on this adapter (module docstring); None: nothing to check (the material's own textures).
+    check: Callable[[Gpu, int, int], None] | None = None
     #: Built for the material's height_scale: a tracer given another scale could step through the surface.
     scale_bound: bool = False
     #: WGSL variable (default NAME_tex); slots that are alternatives for one tracer may share it.
@@ -66,13 +78,103 @@ def depth_range(depth: np.ndarray, fmt: str) -> tuple[float, float]:
     return max(0.0, lo - DEPTH_RANGE_SLACK), min(1.0, hi + DEPTH_RANGE_SLACK)
 
 
+# --- size checks: what a W x H height map makes, against this adapter's limits and maptools' ---------------------
+
+def _fits_texels(w: int, h: int, texels: int) -> str:
+    """The fix for a w x h height map beyond ``texels`` texels: the largest map of its shape within."""
+    scale = min(1.0, (texels / (w * h)) ** 0.5)
+    return f"use a height map of at most {texels} texels (e.g. {max(1, int(w * scale))}x{max(1, int(h * scale))})"
+
+
+def _check_2d(gpu: Gpu, w: int, h: int, what: str = "") -> None:
+    """The map is a w x h 2D texture (a height map of up to the adapter's limit per side fits)."""
+    side = gpu.device.limits["max-texture-dimension-2d"]
+    check_texture_size(gpu, w, h, what or "the map", f"use a height map of at most {side} texels per side")
+
+
+def _atlas_rows(sizes: list[tuple[int, int]]) -> int:
+    return sum(rows for rows, _ in sizes)
+
+
+def _check_atlas(gpu: Gpu, w: int, h: int, rows_of, what: str) -> None:
+    """A pyramid atlas of ``rows_of(h)`` rows (the levels stacked) beyond the adapter's 2D limit: the fix names the
+    tallest height map whose atlas fits."""
+    side = gpu.device.limits["max-texture-dimension-2d"]
+    rows = rows_of(h)
+    if rows > side:
+        fit = side // 2 + 1
+        while fit > 1 and rows_of(fit) > side:
+            fit -= 1
+        raise UserError(f"the {what} atlas of a {w}x{h} height map is {rows} rows, more than this adapter's limit "
+                        f"of {side} texels per side; use a height map of at most {fit} rows")
+
+
+def _check_depth(gpu: Gpu, w: int, h: int) -> None:
+    _check_2d(gpu, w, h)
+
+
+def _check_maxmip(gpu: Gpu, w: int, h: int) -> None:
+    _check_2d(gpu, w, h)
+    _check_atlas(gpu, w, h, lambda rows: _atlas_rows(level_sizes(rows, 1)), "maxmip")
+
+
+def _check_quadmax(gpu: Gpu, w: int, h: int) -> None:
+    _check_2d(gpu, w, h)
+    # quadmax_atlas: the leaves (level 1) and the levels from 2 on; a 1x1 map still gets its one leaf row
+    _check_atlas(gpu, w, h, lambda rows: max(1, _atlas_rows(level_sizes(rows, 1)[1:])), "quadmax")
+
+
+def _check_volume_size(gpu: Gpu, w: int, h: int, depth: int, what: str) -> None:
+    side = gpu.device.limits["max-texture-dimension-3d"]
+    if max(w, h, depth) > side:
+        raise UserError(f"{what}: volume of {w}x{h}x{depth} exceeds this adapter's 3D limit of {side} texels per "
+                        f"side; use a height map of at most {side} texels per side")
+
+
+def _check_distance(gpu: Gpu, w: int, h: int) -> None:
+    slices = DISTANCE_SLICES
+    distance_kind.check_volume(w, h, slices, "distance",
+                               fix=_fits_texels(w, h, distance_kind.MAX_VOXELS // slices))
+    _check_volume_size(gpu, w, h, slices, "distance")
+
+
+def _check_distance_refined(gpu: Gpu, w: int, h: int) -> None:
+    slices, volumes = DISTANCE_SLICES, REFINED_SECTORS * REFINED_BANDS + 1
+    texels = min(distance_kind.MAX_VOXELS // slices, refined_kind.MAX_VALUES // (volumes * slices))
+    refined_kind.check(w, h, slices, REFINED_SECTORS, REFINED_BANDS, fix=_fits_texels(w, h, texels))
+    _check_volume_size(gpu, w, h, volumes * slices, "distance_refined")
+
+
+def _check_cone(gpu: Gpu, w: int, h: int) -> None:
+    _check_2d(gpu, w, h)
+    rings = cone_kind.ring_count(CONE_MAX_RATIO, w, h)
+    if rings > cone_kind.MAX_RINGS:  # maptools' own message names its --max-ratio, which a scene does not have
+        raise UserError(f"cone: a {w}x{h} height map needs {rings} search rings, more than {cone_kind.MAX_RINGS}; "
+                        "use a less elongated height map")
+
+
+def _map_backend(gpu: Gpu, w: int, h: int) -> str:
+    """maptools' backend for a 2D map kind of a w x h height map: its GPU kernel where the map's storage buffers
+    (4 bytes a texel) fit the adapter's limit, else the CPU reference (a scene cannot pick a backend)."""
+    return "auto" if w * h * 4 <= compute_for(gpu).max_buffer else "cpu"
+
+
+def _size(depth: np.ndarray) -> tuple[int, int]:
+    h, w = depth.shape[:2]
+    return w, h
+
+
+# --- builders ------------------------------------------------------------------------------------------------------
+
 def _depth(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    _check_depth(gpu, *_size(depth))
     return create_texture(gpu, mip_chain(depth), gpu.depth_format, label)
 
 
 def _complexity(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    _check_depth(gpu, *_size(depth))
     # Relief textures tile, so the Sobel and the dilation wrap around the borders.
-    levels = cached_generate("complexity", 1.0 - depth, backend="auto", border="repeat")
+    levels = cached_generate("complexity", 1.0 - depth, backend=_map_backend(gpu, *_size(depth)), border="repeat")
     # 8-bit levels k/255 as a filterable float texture (r8unorm has no upload path in gpu.to_texel_data).
     return create_texture(gpu, [levels.astype(np.float32) / 255.0], gpu.depth_format, label)
 
@@ -104,7 +206,8 @@ def maxmip_atlas(levels: list[np.ndarray]) -> np.ndarray:
 
 
 def _maxmip(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
-    levels = cached_generate("maxmip", cell_max_height(depth), backend="auto")
+    _check_maxmip(gpu, *_size(depth))
+    levels = cached_generate("maxmip", cell_max_height(depth), backend=_map_backend(gpu, *_size(depth)))
     return create_texture(gpu, [maxmip_atlas(levels)], "r32float", label)
 
 
@@ -163,23 +266,24 @@ def quadmax_atlas(depth: np.ndarray, levels: list[np.ndarray]) -> np.ndarray:
 
 def _uint_texture(gpu: Gpu, data: np.ndarray, label: str) -> wgpu.GPUTexture:
     h, w = data.shape[:2]
-    limit = gpu.adapter.limits["max-texture-dimension-2d"]
-    if max(w, h) > limit:
-        raise UserError(f"{label}: texture of {w}x{h} exceeds this adapter's limit of {limit} texels per side")
+    _check_2d(gpu, w, h, label)
+    with allocating(gpu, label, w * h * 16, "use a smaller height map"):
+        texture = gpu.device.create_texture(label=label, size=(w, h, 1), format="rgba32uint",
+                                            usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST)
     data = np.ascontiguousarray(data, np.uint32)
-    texture = gpu.device.create_texture(label=label, size=(w, h, 1), format="rgba32uint",
-                                        usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST)
     gpu.device.queue.write_texture({"texture": texture, "mip_level": 0, "origin": (0, 0, 0)}, data,
                                    {"offset": 0, "bytes_per_row": w * 16, "rows_per_image": h}, (w, h, 1))
     return texture
 
 
 def _quadmax(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
-    levels = cached_generate("maxmip", cell_max_height(depth), backend="auto")
+    _check_quadmax(gpu, *_size(depth))
+    levels = cached_generate("maxmip", cell_max_height(depth), backend=_map_backend(gpu, *_size(depth)))
     return _uint_texture(gpu, quadmax_atlas(depth, levels), label)
 
 
 def _auto_table(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str, probe) -> wgpu.GPUTexture:
+    _check_quadmax(gpu, *_size(depth))  # auto's candidates trace the depth and the quadmax atlas
     return autotable.table_texture(gpu, autotable.measure(depth, height_scale, probe), label)
 
 
@@ -187,16 +291,16 @@ def _volume_texture(gpu: Gpu, volume: np.ndarray, label: str) -> wgpu.GPUTexture
     """A (Dz, H, W) float32 volume as an r32float 3D texture, or (V, Dz, H, W) float16 volumes stacked along the
     depth as r16float (volume v at depths [v Dz, (v + 1) Dz))."""
     half = volume.dtype == np.float16
-    data = np.ascontiguousarray(volume.reshape(-1, *volume.shape[-2:]), np.float16 if half else np.float32)
-    depth, h, w = data.shape
-    limit = gpu.adapter.limits["max-texture-dimension-3d"]
-    if max(w, h, depth) > limit:
-        raise UserError(f"{label}: volume of {w}x{h}x{depth} exceeds this adapter's 3D limit of {limit} texels per "
-                        f"side; use a smaller height map")
-    texture = gpu.device.create_texture(
-        label=label, size=(w, h, depth), dimension="3d", format="r16float" if half else "r32float",
-        usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
-    )
+    h, w = volume.shape[-2:]
+    depth = volume.size // (w * h)
+    _check_volume_size(gpu, w, h, depth, label)
+    item = 2 if half else 4
+    with allocating(gpu, label, w * h * depth * item, "use a smaller height map"):
+        texture = gpu.device.create_texture(
+            label=label, size=(w, h, depth), dimension="3d", format="r16float" if half else "r32float",
+            usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
+        )
+    data = np.ascontiguousarray(volume.reshape(depth, h, w), np.float16 if half else np.float32)
     gpu.device.queue.write_texture(
         {"texture": texture, "mip_level": 0, "origin": (0, 0, 0)}, data,
         {"offset": 0, "bytes_per_row": w * data.itemsize, "rows_per_image": h}, (w, h, depth),
@@ -205,12 +309,14 @@ def _volume_texture(gpu: Gpu, volume: np.ndarray, label: str) -> wgpu.GPUTexture
 
 
 def _distance(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    _check_distance(gpu, *_size(depth))
     volume = cached_generate("distance", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
                              height_scale=height_scale)
     return _volume_texture(gpu, volume, label)
 
 
 def _distance_refined(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
+    _check_distance_refined(gpu, *_size(depth))
     volumes = cached_generate("distance_refined", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
                               height_scale=height_scale, max_angle=REFINED_MAX_ANGLE, sectors=REFINED_SECTORS,
                               bands=REFINED_BANDS)
@@ -232,7 +338,9 @@ def _cone(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.
     # The ratios do not depend on height_scale (texels of u per unit t); cone.wgsl reads (ratio, footprint min
     # depth) with textureLoad (nearest texel), the lookup a filter="nearest" map is built for: one fetch per cone
     # step, which proves the ray free where it is above the footprint's lowest depth.
-    ratios = cached_generate("cone", 1.0 - depth, backend="auto", max_ratio=CONE_MAX_RATIO, filter=CONE_FILTER)
+    _check_cone(gpu, *_size(depth))
+    ratios = cached_generate("cone", 1.0 - depth, backend=_map_backend(gpu, *_size(depth)), max_ratio=CONE_MAX_RATIO,
+                             filter=CONE_FILTER)
     packed = np.stack([np.asarray(ratios, np.float32), footprint_min_depth(depth, gpu.depth_format)], axis=-1)
     return create_texture(gpu, [packed], "rg32float", label)
 
@@ -251,23 +359,27 @@ MAP_SLOTS: dict[str, MapSlot] = {
     for slot in (
         MapSlot("albedo", _2D, _FILTERABLE_2D, None, "linear RGB albedo (rgba16float), mip chain"),
         MapSlot("normal", _2D, _FILTERABLE_2D, None, "tangent-space normals as n * 0.5 + 0.5 (rgba8unorm)"),
-        MapSlot("depth", _2D, _FILTERABLE_2D, _depth, "D = 1 - height, mip chain (r32float, or r16float)"),
-        MapSlot("complexity", _2D, _FILTERABLE_2D, _complexity, "the thesis' complexity map, levels k/255"),
+        MapSlot("depth", _2D, _FILTERABLE_2D, _depth, "D = 1 - height, mip chain (r32float, or r16float)",
+                check=_check_depth),
+        MapSlot("complexity", _2D, _FILTERABLE_2D, _complexity, "the thesis' complexity map, levels k/255",
+                check=_check_depth),
         MapSlot("maxmip", _2D, _UNFILTERABLE_2D, _maxmip,
-                "max pyramid atlas (r32float): level m at rows [row_m, row_m + h_m), textureLoad"),
+                "max pyramid atlas (r32float): level m at rows [row_m, row_m + h_m), textureLoad", check=_check_maxmip),
         # distance.wgsl reads whichever of the two distance volumes its technique needs, as distance_tex.
         MapSlot("distance", _3D, _VOLUME, _distance, "distance volume (W, H, slices), r32float, textureLoad",
-                scale_bound=True),
+                check=_check_distance, scale_bound=True),
         MapSlot("distance_refined", _3D, _VOLUME, _distance_refined,
                 "direction-binned refined volumes and the plain one, stacked along the depth (r16float), textureLoad",
-                scale_bound=True, variable="distance_tex"),
+                check=_check_distance_refined, scale_bound=True, variable="distance_tex"),
         MapSlot("cone", _2D, _UNFILTERABLE_2D, _cone,
-                "relaxed cone ratio (texels of u per unit t) and footprint min depth (rg32float), textureLoad"),
+                "relaxed cone ratio (texels of u per unit t) and footprint min depth (rg32float), textureLoad",
+                check=_check_cone),
         MapSlot("quadmax", "texture_2d<u32>", _UINT_2D, _quadmax,
-                "max quadtree atlas (rgba32uint): packed 14-bit leaves (level 1), children's maxima (levels >= 2)"),
+                "max quadtree atlas (rgba32uint): packed 14-bit leaves (level 1), children's maxima (levels >= 2)",
+                check=_check_quadmax),
         MapSlot("auto_table", _2D, _UNFILTERABLE_2D, _auto_table,
                 "auto's choices (rgba32float, bins x budget levels): candidate, method, parameter, error",
-                scale_bound=True, measured=True),
+                check=_check_quadmax, scale_bound=True, measured=True),
     )
 }
 

@@ -25,6 +25,7 @@ from wgpuviewer.core.gpu import Gpu, get_gpu
 from wgpuviewer.core.structs import Struct
 
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
+from .reference import real_array, real_number
 from .shaders import compose_technique, pack_trace_params
 from .techniques import TECHNIQUES, get_technique, resolve_params
 
@@ -129,10 +130,7 @@ def probe(
 
 
 def _check_height_scale(height_scale) -> float:
-    try:
-        scale = float(height_scale)
-    except (TypeError, ValueError):
-        raise InputError(f"probe: height_scale = {height_scale!r}; expected a number") from None
+    scale = real_number(height_scale, "probe: height_scale")
     if not (np.isfinite(scale) and 0.0 <= scale <= MAX_HEIGHT_SCALE):
         raise InputError(f"probe: height_scale = {height_scale!r}; expected a finite relief depth from 0 to "
                          f"{MAX_HEIGHT_SCALE:g} UV units")
@@ -141,7 +139,7 @@ def _check_height_scale(height_scale) -> float:
 
 def _rows(a, width: int, name: str) -> np.ndarray:
     """(width,) or (N, width) finite values -> float64 (N, width); the error names the array."""
-    arr = np.asarray(a, np.float64)
+    arr = real_array(a, f"probe: {name}")
     if arr.ndim == 1 and arr.shape[0] == width:
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != width:

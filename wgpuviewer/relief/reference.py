@@ -26,10 +26,12 @@ steps with arrays over the rays still walking; finished rays leave the active se
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
 
+from wgpuviewer.core.errors import InputError
 from wgpuviewer.core.sampling import bilinear, check_address, wrap_index
 
 #: Default bound on the cells one ray may need (see exact_hit): 89.9 degrees on a 256^2 map with
@@ -50,31 +52,48 @@ class Hit:
     cells: np.ndarray  # (N,) int64, number of cells visited (diagnostic; 0 where invalid)
 
 
+def real_array(a, name: str) -> np.ndarray:
+    """``a`` as a float64 array when it holds real numbers (an integer or floating dtype); an InputError naming
+    ``name`` otherwise: complex numbers would lose their imaginary part and strings would be parsed, silently."""
+    arr = np.asarray(a)
+    if arr.dtype.kind not in "iuf":
+        raise InputError(f"{name} has dtype {arr.dtype}; expected real numbers (an integer or floating array)")
+    return arr.astype(np.float64, copy=False)
+
+
+def real_number(x, name: str) -> float:
+    """``x`` as a float when it is one real number (int, float or a numpy real scalar, not a bool); an InputError
+    naming ``name`` otherwise."""
+    if isinstance(x, bool) or not isinstance(x, numbers.Real):
+        raise InputError(f"{name} = {x!r}; expected a real number")
+    return float(x)
+
+
 def _check_depth(depth) -> np.ndarray:
-    d = np.asarray(depth, dtype=np.float64)
+    d = real_array(depth, "depth")
     if d.ndim != 2 or d.size == 0:
-        raise ValueError(f"depth must be a non-empty 2D array (rows, cols), got shape {d.shape}")
+        raise InputError(f"depth must be a non-empty 2D array (rows, cols), got shape {d.shape}")
     bad = ~np.isfinite(d)
     if bad.any():
         row, col = np.argwhere(bad)[0]
-        raise ValueError(
+        raise InputError(
             f"depth contains {int(bad.sum())} NaN/inf value(s), first at row {row}, col {col}"
         )
     lo, hi = float(d.min()), float(d.max())
     if lo < 0.0 or hi > 1.0:
-        raise ValueError(f"depth values must lie in [0, 1], got range [{lo:g}, {hi:g}]")
+        raise InputError(f"depth values must lie in [0, 1], got range [{lo:g}, {hi:g}]")
     return d
 
 
 def _as_rows(a, width: int, name: str) -> np.ndarray:
-    """(width,) or (N, width) -> finite float64 (N, width)."""
-    arr = np.asarray(a, dtype=np.float64)
+    """(width,) or (N, width) real numbers -> finite float64 (N, width)."""
+    arr = real_array(a, name)
     if arr.ndim == 1:
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != width:
-        raise ValueError(f"{name} must have shape ({width},) or (N, {width}), got {np.shape(a)}")
+        raise InputError(f"{name} must have shape ({width},) or (N, {width}), got {np.shape(a)}")
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} contains NaN/inf")
+        raise InputError(f"{name} contains NaN/inf")
     return arr
 
 
@@ -151,8 +170,8 @@ def exact_hit(
 
     Rays with V.z <= 0 (exactly grazing or back-facing) never descend into the relief: they are
     returned with ``valid = False``, NaN ``t`` and ``uv``, and 0 cells; they do not raise.
-    NaN/inf or values outside [0, 1] in ``depth``, or non-finite ``uv``/``view_dir``, raise
-    ValueError.
+    NaN/inf or values outside [0, 1] in ``depth``, non-finite ``uv``/``view_dir``, or anything but real numbers
+    (complex, strings) raise InputError (a ValueError).
 
     Cost is one step per cell crossed, about (t* * S * tan(theta)) * (W |cos phi| + H |sin phi|)
     steps: a grazing ray at 89.9 degrees crosses thousands of cells on a 256-texel map. To stay
@@ -167,14 +186,14 @@ def exact_hit(
     try:
         n = np.broadcast_shapes((len(p),), (len(v),))[0]
     except ValueError:
-        raise ValueError(f"uv has {len(p)} rows but view_dir has {len(v)}") from None
+        raise InputError(f"uv has {len(p)} rows but view_dir has {len(v)}") from None
     p = np.broadcast_to(p, (n, 2))
     v = np.broadcast_to(v, (n, 3))
-    scale = float(height_scale)
+    scale = real_number(height_scale, "height_scale")
     if not np.isfinite(scale) or scale < 0.0:
-        raise ValueError(f"height_scale must be finite and >= 0, got {height_scale!r}")
-    if not max_cells >= 1:
-        raise ValueError(f"max_cells must be >= 1, got {max_cells!r}")
+        raise InputError(f"height_scale must be finite and >= 0, got {height_scale!r}")
+    if not real_number(max_cells, "max_cells") >= 1:
+        raise InputError(f"max_cells must be >= 1, got {max_cells!r}")
 
     rows, cols = d.shape
     flat = d.ravel()
@@ -237,9 +256,8 @@ def uv_error_texels(uv_a, uv_b, size_wh) -> np.ndarray:
     ``size_wh`` = (W, H). Each axis difference is reduced to the nearest periodic image, so
     u = 0.999 and u = 0.001 on a 100-wide map are 0.2 texels apart.
     """
-    wh = np.asarray(size_wh, dtype=np.float64)
-    delta = (np.atleast_2d(np.asarray(uv_a, dtype=np.float64))
-             - np.atleast_2d(np.asarray(uv_b, dtype=np.float64))) * wh
+    wh = real_array(size_wh, "size_wh")
+    delta = (np.atleast_2d(real_array(uv_a, "uv_a")) - np.atleast_2d(real_array(uv_b, "uv_b"))) * wh
     delta -= np.round(delta / wh) * wh
     return np.hypot(delta[:, 0], delta[:, 1])
 
@@ -248,8 +266,8 @@ def view_dir_from_angles(theta_deg, phi_deg) -> np.ndarray:
     """Unit tangent-space V at angle theta from the normal (0 = looking straight down,
     90 = grazing) and azimuth phi: (sin t cos p, sin t sin p, cos t). Broadcasts; shape (..., 3).
     """
-    theta = np.asarray(theta_deg, dtype=np.float64)
-    t, p = np.broadcast_arrays(np.radians(theta), np.radians(np.asarray(phi_deg, dtype=np.float64)))
+    theta = real_array(theta_deg, "theta_deg")
+    t, p = np.broadcast_arrays(np.radians(theta), np.radians(real_array(phi_deg, "phi_deg")))
     # cos(radians(90)) is 6e-17, not 0: that would be a valid ray walking ~1e16 cells. Exactly
     # grazing must give V.z == 0 so exact_hit flags it invalid.
     z = np.where(np.mod(theta, 180.0) == 90.0, 0.0, np.cos(t))

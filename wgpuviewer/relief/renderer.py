@@ -23,7 +23,8 @@ from maptools.cache import cached_generate
 from wgpuviewer import camera as cam
 from wgpuviewer import meshes, textures
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.gpu import Gpu, create_texture, mip_chain
+from wgpuviewer.core.gpu import Gpu, allocating, create_texture, format_bytes, mip_chain
+from wgpuviewer.core.images import read_header
 from wgpuviewer.core.structs import FragmentOutputs
 from wgpuviewer.scene import Camera, Scene
 
@@ -58,6 +59,11 @@ DATA_OUT = FragmentOutputs("DataOut", [
     ("filtering", "vec4u", FILTER_FORMAT),
 ])
 OFFSCREEN_FORMATS = DATA_OUT.formats
+
+#: Bytes per pixel of the offscreen targets and the depth attachment.
+_PIXEL_BYTES = {"rgba8unorm-srgb": 4, "rgba32uint": 16, "r32uint": 4, "depth32float": 4}
+#: What a user can do about a frame too large for the adapter.
+SMALLER_FRAME = "use a smaller size"
 
 #: Frame.mode values (render.wgsl).
 MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4, "albedo": 5}
@@ -197,12 +203,24 @@ class Renderer:
         ``progress(label, done, total)``: what ``render``/``encode`` would otherwise build on first use. The
         viewer calls it from a worker thread while it keeps drawing; problems raise UserError naming the key."""
         todo = self.missing(technique)
+        for material, kind in todo:  # all refused before any is loaded or generated
+            self.check_map(material, kind)
         for done, (material, kind) in enumerate(todo):
             if progress is not None:
                 progress(f"{material}.{kind}", done, len(todo))
             self.texture(material, kind)
         if progress is not None:
             progress("done", len(todo), len(todo))
+
+    def check_map(self, material_name: str, kind: str) -> None:
+        """Refuse slot ``kind`` of a material when its height map's size (a file's header, a builtin's size: nothing
+        is loaded) is beyond what the map can be built at on this adapter (``MapSlot.check``): a UserError
+        against the scene's height key. Slots without a check (the material's own textures) pass."""
+        slot = MAP_SLOTS[kind]
+        if slot.check is not None:
+            material = self.scene.materials[material_name]
+            with _reported_against(material.height, kind):
+                slot.check(self.gpu, *_height_size(material))
 
     def texture(self, material_name: str, kind: str) -> wgpu.GPUTexture:
         """The GPU texture of slot ``kind`` (maps.MAP_SLOTS) of a material, built on first use."""
@@ -212,20 +230,24 @@ class Renderer:
             label = f"{material_name}.{kind}"
             slot = MAP_SLOTS[kind]
             if slot.derived:
+                self.check_map(material_name, kind)
                 depth = self._depth_data(material)
                 if material_name not in self._depth_ranges:  # while the depth is loaded anyway
                     self._depth_ranges[material_name] = depth_range(depth, self.gpu.depth_format)
                 measured = (probe,) if slot.measured else ()  # auto's table: measured with the probe
-                with _reported_against_height(material, kind):
+                with _reported_against(material.height, kind):
                     self._textures[key] = slot.build(self.gpu, depth, material.height_scale, label, *measured)
             else:
                 if kind == "normal":
                     data = self._normal_data(material)  # our own copy: encoded in place, n * 0.5 + 0.5
                     data *= 0.5
                     data += 0.5
+                    source = material.normal or material.height
                 else:
                     data = textures.load_albedo(material.albedo)
-                self._textures[key] = create_texture(self.gpu, mip_chain(data), _MATERIAL_FORMATS[kind], label)
+                    source = material.albedo
+                with _reported_against(source, kind):
+                    self._textures[key] = create_texture(self.gpu, mip_chain(data), _MATERIAL_FORMATS[kind], label)
                 del data
             self.created.append(f"texture:{label}")
         return self._textures[key]
@@ -261,7 +283,7 @@ class Renderer:
         # Slopes of the actual relief: height_scale UV units deep over a texture width of 1 UV unit.
         # maptools' "directx" convention has +y towards increasing rows, which is +v here.
         strength = material.height_scale * height.shape[1]
-        with _reported_against_height(material, "normal"):
+        with _reported_against(material.height, "normal"):
             return cached_generate("normal", height, backend="cpu", strength=strength, y="directx")
 
     def _material_layout(self, technique: Technique) -> wgpu.GPUBindGroupLayout:
@@ -472,22 +494,27 @@ class Renderer:
         rpass.end()
 
     def render(self, draw: DrawConfig | str, size: tuple[int, int], camera: Camera | None = None,
-               mode: str = "color") -> OffscreenImage:
+               mode: str = "color", *, size_name: str = "render size") -> OffscreenImage:
         """Draw offscreen and read back the colour, the raw trace data and the filter's statistics. ``draw``: a
         DrawConfig, or a technique name (drawn with the scene's parameters for it). ``mode`` "albedo" makes the
-        colour the filtered albedo, unlit; every other mode reads the shaded colour."""
+        colour the filtered albedo, unlit; every other mode reads the shaded colour. A frame too large for the
+        adapter (``check_frame_size``, or its memory) is a UserError naming ``size_name`` (the CLI: ``--size``)."""
         if isinstance(draw, str):
             draw = self.config(draw)
+        check_frame_size(self.gpu, size, size_name)
         device = self.gpu.device
         w, h = size
+        frame = f"{size_name} {w}x{h}"
         usage = wgpu.TextureUsage.RENDER_ATTACHMENT | wgpu.TextureUsage.COPY_SRC
-        color = device.create_texture(label="offscreen:color", size=(w, h, 1), format=COLOR_FORMAT, usage=usage)
-        data = device.create_texture(label="offscreen:data", size=(w, h, 1), format=DATA_FORMAT, usage=usage)
-        layers = device.create_texture(label="offscreen:layers", size=(w, h, 1), format=LAYERS_FORMAT, usage=usage)
-        stats = device.create_texture(label="offscreen:filter", size=(w, h, 1), format=FILTER_FORMAT, usage=usage)
-        depth = device.create_texture(
-            label="offscreen:depth", size=(w, h, 1), format=DEPTH_FORMAT, usage=wgpu.TextureUsage.RENDER_ATTACHMENT
-        )
+        with allocating(self.gpu, frame, frame_bytes(size), SMALLER_FRAME):
+            color = device.create_texture(label="offscreen:color", size=(w, h, 1), format=COLOR_FORMAT, usage=usage)
+            data = device.create_texture(label="offscreen:data", size=(w, h, 1), format=DATA_FORMAT, usage=usage)
+            layers = device.create_texture(label="offscreen:layers", size=(w, h, 1), format=LAYERS_FORMAT,
+                                           usage=usage)
+            stats = device.create_texture(label="offscreen:filter", size=(w, h, 1), format=FILTER_FORMAT,
+                                          usage=usage)
+            depth = device.create_texture(label="offscreen:depth", size=(w, h, 1), format=DEPTH_FORMAT,
+                                          usage=wgpu.TextureUsage.RENDER_ATTACHMENT)
         encoder = device.create_command_encoder(label="offscreen")
         self.encode(
             encoder, [color.create_view(), data.create_view(), layers.create_view(), stats.create_view()],
@@ -495,23 +522,74 @@ class Renderer:
             camera or self.scene.camera, size, "albedo" if mode == "albedo" else "color",
         )
         device.queue.submit([encoder.finish()])
-        return OffscreenImage(
-            color=_read_texture(device, color, 4, np.uint8),
-            data=_read_texture(device, data, 4, np.uint32).view(np.float32),
-            layers=_read_texture(device, layers, 1, np.uint32)[:, :, 0],
-            layer_range=get_technique(draw.technique).layer_range(draw.values),
-            filter=_read_texture(device, stats, 4, np.uint32),
-        )
+        with allocating(self.gpu, f"reading back {frame}", readback_bytes(w, h, DATA_FORMAT), SMALLER_FRAME):
+            return OffscreenImage(
+                color=_read_texture(device, color, 4, np.uint8),
+                data=_read_texture(device, data, 4, np.uint32).view(np.float32),
+                layers=_read_texture(device, layers, 1, np.uint32)[:, :, 0],
+                layer_range=get_technique(draw.technique).layer_range(draw.values),
+                filter=_read_texture(device, stats, 4, np.uint32),
+            )
+
+
+def frame_bytes(size: tuple[int, int]) -> int:
+    """GPU memory of an offscreen frame of ``size``: its targets and depth attachment."""
+    w, h = size
+    return w * h * sum(_PIXEL_BYTES[f] for f in (*OFFSCREEN_FORMATS, DEPTH_FORMAT))
+
+
+def readback_bytes(w: int, h: int, fmt: str) -> int:
+    """Bytes of the buffer a w x h target of ``fmt`` is read back through: rows padded to 256 bytes and the whole
+    to 4096, as wgpu's ``read_texture`` makes it."""
+    row = -(-w * _PIXEL_BYTES[fmt] // 256) * 256
+    return -(-row * h // 4096) * 4096
+
+
+def check_frame_size(gpu: Gpu, size: tuple[int, int], size_name: str = "render size") -> None:
+    """Refuse an offscreen frame of ``size`` the adapter cannot make or read back, before anything is loaded or
+    drawn: a side beyond its 2D texture limit, or a target whose read-back buffer is beyond its largest buffer.
+    The UserError names ``size_name`` (the option the size came from) and the largest frame of that shape that
+    fits."""
+    w, h = size
+    limits = gpu.device.limits
+    side = limits["max-texture-dimension-2d"]
+    if max(w, h) > side:
+        raise UserError(f"{size_name} {w}x{h}: larger than this adapter's limit of {side} pixels per side; "
+                        f"use at most {side} per side")
+    largest = limits["max-buffer-size"]
+    fmt = max(OFFSCREEN_FORMATS, key=lambda f: readback_bytes(w, h, f))
+    need = readback_bytes(w, h, fmt)
+    if need > largest:
+        scale = (largest / need) ** 0.5
+        fw, fh = max(1, int(w * scale)), max(1, int(h * scale))
+        while readback_bytes(fw, fh, fmt) > largest:  # the row padding: shrink a little more
+            fw, fh = max(1, fw - 1 - fw // 100), max(1, fh - 1 - fh // 100)
+        raise UserError(f"{size_name} {w}x{h}: its {fmt} target is read back through a {format_bytes(need)} "
+                        f"buffer, more than this adapter's largest buffer of {format_bytes(largest)}; use at most "
+                        f"{fw}x{fh}")
+
+
+def _height_size(material) -> tuple[int, int]:
+    """(width, height) of a material's height map without loading it: a builtin's size, a file's header; (1, 1)
+    without one (the renderer's flat depth)."""
+    ref = material.height
+    if ref is None:
+        return 1, 1
+    if ref.kind == "file":
+        with textures.reported_against(ref):
+            header = read_header(ref.path)
+        return header.width, header.height
+    return tuple(ref.size)
 
 
 @contextlib.contextmanager
-def _reported_against_height(material, kind: str):
-    """A map derived from a material's height map that cannot be built (too large for a limit, ...) is reported
-    against the height key of the scene, not against the derived map the user never named."""
+def _reported_against(ref, kind: str):
+    """A texture of slot ``kind`` that cannot be built (too large for a limit or for the adapter's memory, ...) is
+    reported against the scene key of the texture it comes from (``ref``; the height map for a derived map), not
+    against the map the user never named."""
     try:
         yield
     except UserError as error:
-        ref = material.height
         if ref is None or not ref.origin:
             raise
         raise ref.error(f"its {kind} map cannot be built: {error}") from None

@@ -18,9 +18,10 @@ import tomllib
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
+from wgpuviewer.core import env
 from wgpuviewer.core.errors import UserError
 
-CONFIG_ENV = "WGPUVIEWER_CONFIG_DIR"
+CONFIG_ENV = env.CONFIG_DIR.name
 FILE_NAME = "settings.toml"
 #: Bumped when the meaning of a key changes; a file with another version is replaced by defaults.
 VERSION = 1
@@ -56,9 +57,9 @@ LIMITS = {
 
 
 def config_dir() -> Path:
-    override = os.environ.get(CONFIG_ENV)
+    override = env.CONFIG_DIR.value()
     if override:
-        return Path(override)
+        return override
     if sys.platform.startswith("win"):
         base = os.environ.get("APPDATA")
         return Path(base) / "wgpuviewer" if base else Path.home() / "AppData" / "Roaming" / "wgpuviewer"

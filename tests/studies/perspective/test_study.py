@@ -5,6 +5,10 @@ from __future__ import annotations
 
 import csv
 import math
+import signal
+import subprocess
+import sys
+import textwrap
 
 import pytest
 from PIL import Image
@@ -122,3 +126,37 @@ def test_bad_command_lines_fail_with_one_line(tmp_path, capsys):
         assert cli.main(argv) == 2
         err = capsys.readouterr().err.strip()
         assert err.count("\n") == 0 and "--help" in err
+
+
+#: ``wgpuviewer perspective`` whose measurement stops in its first plot's write (the real study takes ~20 s on
+#: the software adapter before it writes anything).
+STOPPED_MID_WRITE = textwrap.dedent("""
+    import sys, time
+    from wgpuviewer import cli
+    from wgpuviewer.core.io import atomic_open
+    from wgpuviewer.studies.perspective import run as study
+
+    def run(*args, **kwargs):
+        with atomic_open(sys.argv[1] + "/error_along_span.png") as f:
+            f.write(b"partial")
+            f.flush()
+            print("writing", flush=True)
+            time.sleep(60)
+
+    study.run = run
+    sys.exit(cli.main(["perspective", "--out", sys.argv[1], "--suite", "smoke", "--quiet"]))
+""")
+
+
+def test_sigterm_mid_write_leaves_no_temp(tmp_path):
+    proc = subprocess.Popen([sys.executable, "-c", STOPPED_MID_WRITE, str(tmp_path)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "writing"
+        assert [p.name for p in tmp_path.glob(".error_along_span.png.*.tmp")]
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    assert proc.returncode == 143 and err.strip() == "wgpuviewer: terminated", err
+    assert list(tmp_path.iterdir()) == []

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from wgpuviewer.core.cli import comma_list, comma_numbers, parse_size
-from wgpuviewer.core.io import output_dir
 from wgpuviewer.harness.study import add_measurement_options
 
 
@@ -25,8 +24,8 @@ class Filtering:
         parser.add_argument("--footprints", help="comma-separated texels per pixel at the frame centre, e.g. 1,4")
         parser.add_argument("--filters", help="comma-separated filter names (trilinear, the baseline, always runs)")
 
-    def run(self, args) -> int:
-        from .run import run
+    def options(self, args) -> dict:
+        """``run.run``'s keyword arguments: the suite narrowed by the options (each checked)."""
         from .suites import resolve_options
 
         options = resolve_options(
@@ -35,9 +34,13 @@ class Filtering:
             angles=comma_numbers(args.angles, "--angles", "0,45,80"),
             footprints=comma_numbers(args.footprints, "--footprints", "1,4"),
             filters=comma_list(args.filters, "--filters"), backend=args.backend, command=args.command_line)
-        out = output_dir(args.out, "--out")
-        run(options, out, progress=not args.quiet)
-        print(Path(out) / "report.md")
+        return {"options": options, "progress": not args.quiet}
+
+    def run(self, options: dict, out: Path) -> int:
+        from .run import run
+
+        run(out=out, **options)
+        print(out / "report.md")
         return 0
 
 

@@ -18,7 +18,6 @@ from pathlib import Path
 import numpy as np
 
 from wgpuviewer.core.gpu import get_gpu
-from wgpuviewer.core.io import output_dir
 from wgpuviewer.harness.header import Clock
 from wgpuviewer.relief.filters import FLAGS
 from wgpuviewer.relief.renderer import Renderer
@@ -106,7 +105,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     from . import report
 
     suite = options.suite
-    out = output_dir(out, "--out")
+    out = Path(out)  # checked and made by the command first (harness.study.run_study)
     gpu = get_gpu(options.backend)
     rows, kept = [], []
     total = len(suite.cases) * len(suite.configs)

@@ -16,11 +16,16 @@ class Perspective:
         add_measurement_options(parser, "output folder (results.csv, report.md, *.png)",
                                 "full: every sweep, 4K frames (minutes on a software adapter); smoke: seconds, for CI")
 
-    def run(self, args) -> int:
+    def options(self, args) -> dict:
+        """``run.run``'s keyword arguments (argparse has checked the suite)."""
+        return {"suite_name": args.suite, "backend": args.backend, "progress": not args.quiet,
+                "command": args.command_line}
+
+    def run(self, options: dict, out: Path) -> int:
         from .run import run
 
-        run(args.suite, Path(args.out), backend=args.backend, progress=not args.quiet, command=args.command_line)
-        print(Path(args.out) / "report.md")
+        run(out=out, **options)
+        print(out / "report.md")
         return 0
 
 

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wgpuviewer.core.io import output_dir, write_bytes
+from wgpuviewer.core.io import write_bytes
 from wgpuviewer.harness import suite as harness_suite
 from wgpuviewer.harness.header import Clock
 from wgpuviewer.harness.table import Column, Table
@@ -296,14 +296,15 @@ class Measurements:
 
 def run(suite_name: str, out: Path, backend: str | None = None, progress: bool = True,
         command: str = "wgpuviewer perspective") -> list[dict]:
-    """Run the study; write ``out``/results.csv, along_span.csv, tieback.csv, report.md and the plots."""
+    """Run the study; write results.csv, along_span.csv, tieback.csv, report.md and the plots into ``out`` (the
+    command checks and makes it first: ``harness.study.run_study``)."""
     from tqdm import tqdm
 
     from .plots import write_plots
     from .report import TITLE, report_text
 
     suite = harness_suite.pick(SUITES, suite_name)
-    out = output_dir(out, "--out")  # before minutes of work, not after
+    out = Path(out)
     clock = Clock()
     study = Measurements(suite, backend)
     configs = ([("span_length", Setup(span_length=n, rows=suite.rows, tilt=SWEEP_TILT)) for n in suite.span_lengths]

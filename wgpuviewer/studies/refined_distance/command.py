@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from wgpuviewer.core.cli import comma_list, comma_numbers
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.io import output_dir
 from wgpuviewer.harness.study import add_measurement_options
 
 
@@ -20,16 +21,22 @@ class RefinedDistance:
         parser.add_argument("--heightmaps", help="comma-separated: builtins and/or scikit-image brick,grass,gravel")
         parser.add_argument("--angles", help="comma-separated view angles at the frame centre, degrees (0 to 85)")
 
-    def run(self, args) -> int:
-        from .run import run
+    def options(self, args) -> dict:
+        """``run.run``'s keyword arguments, each option checked."""
+        from .run import check_heightmaps
 
         angles = comma_numbers(args.angles, "--angles", "45,80")
         if angles is not None and not all(0.0 <= a <= 85.0 for a in angles):
             raise UserError(f"--angles {args.angles!r}: expected degrees from 0 to 85")
         heightmaps = comma_list(args.heightmaps, "--heightmaps")
-        out = output_dir(args.out, "--out")
-        run(args.suite, out, heightmaps=heightmaps, angles=angles, backend=args.backend, progress=not args.quiet,
-            command=args.command_line)
+        check_heightmaps(heightmaps or [])
+        return {"suite_name": args.suite, "heightmaps": heightmaps, "angles": angles, "backend": args.backend,
+                "progress": not args.quiet, "command": args.command_line}
+
+    def run(self, options: dict, out: Path) -> int:
+        from .run import run
+
+        run(out=out, **options)
         print(out / "report.md")
         return 0
 

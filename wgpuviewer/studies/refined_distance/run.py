@@ -102,6 +102,21 @@ def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[n
     return out, time.perf_counter() - t0
 
 
+def check_heightmaps(names: list[str]) -> None:
+    """A UserError naming --heightmaps for a name that is no builtin or scikit-image map, or a scikit-image map
+    without scikit-image (checked before the output folder is made or the GPU starts)."""
+    from wgpuviewer.bench.run import REAL_MAPS, skimage_available
+    from wgpuviewer.textures import BUILTINS
+
+    known = (*BUILTINS, *REAL_MAPS)
+    for name in names:
+        if name not in known:
+            raise UserError(f"--heightmaps: unknown height map {name!r}; expected some of {', '.join(known)}")
+        if name in REAL_MAPS and not skimage_available():
+            raise UserError(f"--heightmaps: {name!r} needs scikit-image; install it with "
+                            f"pip install 'wgpuviewer[bench]'")
+
+
 def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str | None = None,
         progress: bool = True, command: str = "wgpuviewer refined-distance") -> list[dict]:
     """Measure every variant of ``SUITES[suite_name]``; write ``out``/results.csv and report.md; return the rows."""
@@ -119,15 +134,11 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
         maps = tuple(m for m in maps if m not in REAL_MAPS)
     gpu = get_gpu(backend, quiet=True)
     rows: list[dict] = []
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = Path(out)  # checked and made by the command first (harness.study.run_study)
     with tempfile.TemporaryDirectory(prefix="wgpuviewer-refined-") as workdir, \
             tqdm(total=len(maps) * len(VARIANTS), desc="refined-distance", unit="map", disable=not progress) as bar:
         for name in maps:
-            try:
-                heightmap = load_heightmap(name, suite.builtin_size, Path(workdir))
-            except KeyError:
-                raise UserError(f"--heightmaps: unknown height map {name!r}") from None
+            heightmap = load_heightmap(name, suite.builtin_size, Path(workdir))
             depth = 1.0 - heightmap.height.astype(np.float64)
             views = [make_view(heightmap, a, suite.resolution) for a in (angles or suite.angles)]
             for variant in VARIANTS:
