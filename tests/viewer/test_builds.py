@@ -89,3 +89,46 @@ def test_a_build_no_longer_wanted_is_not_shown():
     assert builds.current.wait(10)
     builds.poll()
     assert shown["A"] == "parallax" and builds.current is None
+
+
+class SteppedRenderer(FakeRenderer):
+    """Builds a technique's maps one by one, reporting each before building it (as Renderer.prepare does); the
+    first sets ``building`` and waits for ``gate``."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.building = threading.Event()
+
+    def prepare(self, name, progress=None):
+        for done, step in enumerate(("normal", "depth", "distance")):
+            progress(f"m.{step}", done, 3)
+            if done == 0:
+                self.building.set()
+                self.gate.wait(10)
+            self.prepared.append(f"{name}:{step}")
+        self.built.add(name)
+
+
+def test_closing_the_window_stops_a_build_after_the_map_under_way_and_waits_for_it(capsys):
+    gate = threading.Event()
+    renderer = SteppedRenderer(built={"normal"}, gate=gate)
+    builds, shown, problems = builds_for(renderer, background=True)
+    builds.request("A", "distance")
+    build = builds.current
+    assert renderer.building.wait(10)
+    builds.cancel()  # the window starts closing while the first map builds
+    assert not build.finished
+    threading.Timer(1.5, gate.set).start()  # the map under way takes a while: stop() says why it waits
+    builds.stop()
+    assert build.finished and builds.current is None
+    assert renderer.prepared == ["distance:normal"]  # finished; depth and distance were never started
+    assert shown["A"] == "normal" and problems == [] and build.error is None
+    assert capsys.readouterr().err == ("wgpuviewer: the window has closed; the distance build stops once m.normal "
+                                       "is built\n")
+
+
+def test_stopping_without_a_build_under_way_does_nothing():
+    builds, shown, problems = builds_for(FakeRenderer(built={"normal"}), background=True)
+    builds.cancel()
+    builds.stop()
+    assert builds.current is None and shown["A"] == "normal" and problems == []

@@ -2,16 +2,19 @@
 
 from __future__ import annotations
 
+import contextlib
 import logging
 
 import pytest
+import wgpu
 
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.viewer import runner
 
 
 class ToolkitWindow:
-    """Calls the draw function ``asks`` times, whether or not it closed meanwhile."""
+    """Calls the draw function ``asks`` times, whether or not it closed meanwhile; a cancelled draw is skipped, as
+    rendercanvas does."""
 
     def __init__(self, asks: int):
         self.asks, self.closed, self.draw = asks, False, None
@@ -21,7 +24,8 @@ class ToolkitWindow:
 
     def run(self):
         for _ in range(self.asks):
-            self.draw()
+            with contextlib.suppress(wgpu.DrawCancelled):
+                self.draw()
 
     def close(self):
         self.closed = True
@@ -34,6 +38,11 @@ class FakeViewer:
 
     def press(self, key):
         self.events.append(f"press {key}")
+        if key == "Escape":
+            self.window.close()
+
+    def stop_builds(self):
+        self.events.append("stop builds")
 
     def draw(self):
         frame = sum(e == "draw" for e in self.events)
@@ -49,8 +58,18 @@ def test_a_scripted_run_presses_one_key_per_frame_and_stops_drawing_once_closed(
     window = ToolkitWindow(asks=6)
     viewer = FakeViewer(window)
     assert runner.run(viewer, frames=3, keys=["b", "f"]) == 0
-    assert viewer.events == ["press b", "draw", "press f", "draw", "draw"]
+    assert viewer.events == ["press b", "draw", "press f", "draw", "draw", "stop builds"]
     assert window.closed
+
+
+def test_escape_ends_a_script_before_any_further_draw(capsys, tmp_path):
+    window = ToolkitWindow(asks=6)
+    viewer = FakeViewer(window)
+    shot = tmp_path / "shot.png"
+    assert runner.run(viewer, frames=5, screenshot=str(shot), keys=["b", "Escape", "f"]) == 0
+    assert viewer.events == ["press b", "draw", "press Escape", "stop builds"]  # f is never pressed
+    assert capsys.readouterr().err == f"wgpuviewer: the window was closed after 1 of 5 frames; {shot} not written\n"
+    assert not shot.exists()
 
 
 def test_an_error_in_a_frame_ends_a_scripted_run_and_is_raised_after_the_loop():
@@ -58,7 +77,7 @@ def test_an_error_in_a_frame_ends_a_scripted_run_and_is_raised_after_the_loop():
     viewer = FakeViewer(window, fail_at=1)
     with pytest.raises(UserError, match="cannot write"):
         runner.run(viewer, frames=4)
-    assert viewer.events == ["draw", "draw"] and window.closed
+    assert viewer.events == ["draw", "draw", "stop builds"] and window.closed
 
 
 @pytest.fixture
@@ -77,7 +96,7 @@ def test_an_interactive_run_draws_until_closed(own_logger):
     window = ToolkitWindow(asks=4)
     viewer = FakeViewer(window, log_error_at=0)
     assert runner.run(viewer) == 0  # logged errors fail scripted runs only
-    assert viewer.events.count("draw") == 4 and not window.closed
+    assert viewer.events.count("draw") == 4 and not window.closed and viewer.events[-1] == "stop builds"
 
 
 def test_the_script_is_checked_before_any_window_opens(tmp_path):

@@ -99,6 +99,7 @@ class Viewer:
         self.frame_size = (0, 0)
         self.scripted = scripted
         self.window = Window(gui, self.gpu, size or (s.width, s.height), scripted=scripted, vsync=self.vsync)
+        self.window.on_closing(self.builds.cancel)  # a map build stops as soon as the window closes
         self._last_time = time.perf_counter()
         self.stats = FrameStats()
         self.timer = GpuTimer(self.gpu.device) if GpuTimer.available(self.gpu) else None
@@ -330,6 +331,10 @@ class Viewer:
 
     def quit(self, key: str):
         self.window.close()
+
+    def stop_builds(self):
+        """The window has closed: the map build under way stops (the run loop calls this once it ends)."""
+        self.builds.stop()
 
     def _update_title(self):
         what = " | ".join(f"{h.technique} {h.filter} ({h.derivatives})" for _, h in self.state.shown())

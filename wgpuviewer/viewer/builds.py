@@ -1,15 +1,22 @@
 """Building what a technique needs (texture files, derived maps: a 3D distance map takes a minute) on a worker
 thread while the window keeps drawing the technique shown; the HUD shows the progress line, and a problem (a bad
-texture file) comes back as a message instead of ending the viewer.
+texture file) comes back as a message instead of ending the viewer. When the window closes, the build under way
+stops after the map it is building and the viewer waits for it: no thread uses the device while the interpreter
+exits.
 """
 
 from __future__ import annotations
 
+import sys
 import threading
 import time
 
 from wgpuviewer.core.cli import save_traceback
 from wgpuviewer.core.errors import InputError, UserError
+
+
+class _Cancelled(Exception):
+    """Raised in the worker at the next map once ``MapBuild.cancel`` was called."""
 
 
 class MapBuild:
@@ -20,12 +27,15 @@ class MapBuild:
         self.label, self.done, self.total = "", 0, 0
         self.error: str | None = None
         self.started = time.perf_counter()
+        self._cancel = threading.Event()
         self._thread = threading.Thread(target=self._run, args=(renderer,), name=f"maps:{technique}", daemon=True)
         self._thread.start()
 
     def _run(self, renderer) -> None:
         try:
             renderer.prepare(self.technique, self._progress)
+        except _Cancelled:
+            pass
         except (UserError, InputError) as error:
             self.error = str(error)
         except Exception as error:  # noqa: BLE001 - a bug must not end the viewer; it is reported with its trace
@@ -34,7 +44,14 @@ class MapBuild:
                           f"(a bug; traceback {f'saved to {saved}' if saved else 'not saved'})")
 
     def _progress(self, label: str, done: int, total: int) -> None:
+        # prepare reports each map before it builds it: the one place a build can stop between maps
+        if self._cancel.is_set():
+            raise _Cancelled
         self.label, self.done, self.total = label, done, total
+
+    def cancel(self) -> None:
+        """Stop before the next map (the one being built is finished: a GPU dispatch cannot be interrupted)."""
+        self._cancel.set()
 
     @property
     def finished(self) -> bool:
@@ -97,3 +114,20 @@ class Builds:
         for side, name in self.wanted.items():
             if self.current is None and not self.ready(name):
                 self.current = MapBuild(self.renderer, name, side)
+
+    def cancel(self) -> None:
+        """The window is closing: the build under way stops after the map it is building."""
+        if self.current is not None:
+            self.current.cancel()
+
+    def stop(self) -> None:
+        """The window has closed: cancel the build under way and wait for it (nothing it built is shown), so that
+        no thread uses the device while the interpreter exits."""
+        build, self.current = self.current, None
+        if build is None:
+            return
+        build.cancel()
+        if not build.wait(1.0):
+            print(f"wgpuviewer: the window has closed; the {build.technique} build stops once "
+                  f"{build.label or 'its current map'} is built", file=sys.stderr)
+            build.wait()

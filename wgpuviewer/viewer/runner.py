@@ -2,7 +2,9 @@
 
 Scripted runs (tests, demos): ``frames`` frames, ``keys`` pressed one per frame, the last frame (HUD included) saved
 to ``screenshot``; an ERROR logged while drawing makes the run exit 1, an error inside a frame ends it (exit 2 for a
-UserError). Once the window closes no frame is drawn, even when the toolkit asks for one more.
+UserError). A key that closes the window (Escape) ends the script: no frame is drawn once the window is closing, even
+when the toolkit asks for one more, a run closed before its last frame says so (and writes no screenshot), and a map
+build under way stops before the run returns.
 """
 
 from __future__ import annotations
@@ -10,6 +12,8 @@ from __future__ import annotations
 import logging
 import sys
 from pathlib import Path
+
+import wgpu
 
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import refuse_directory
@@ -58,11 +62,11 @@ def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=(
         logging.getLogger(name).addHandler(errors)
 
     def frame():
-        if window.closed:  # the toolkit may ask once more after close: its surface is gone
-            return
         try:
-            if pending:
+            if pending and not window.closed:
                 viewer.press(pending.pop(0))
+            if window.closed:  # Escape, or the toolkit asking once more: the surface is going, draw nothing
+                raise wgpu.DrawCancelled("the window is closing")
             texture = viewer.draw()
             state["frame"] += 1
             if frames is not None and state["frame"] >= frames:
@@ -70,6 +74,8 @@ def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=(
                     save_rgb_png(Path(screenshot), viewer.read_frame(texture))
                     print(screenshot)
                 window.close()
+        except wgpu.DrawCancelled:
+            raise  # the toolkit skips this frame
         except BaseException as error:
             # rendercanvas would log it and call us again forever: stop, and report it after the loop.
             if frames is None and not isinstance(error, UserError):
@@ -81,10 +87,14 @@ def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=(
     try:
         window.run()
     finally:
+        viewer.stop_builds()
         for name in LOGGERS:
             logging.getLogger(name).removeHandler(errors)
     if "error" in state:
         raise state["error"]
+    if frames is not None and state["frame"] < frames:
+        skipped = f"; {screenshot} not written" if screenshot else ""
+        print(f"wgpuviewer: the window was closed after {state['frame']} of {frames} frames{skipped}", file=sys.stderr)
     if frames is not None and errors.count:
         print(f"wgpuviewer: error: {errors.count} error(s) logged while drawing", file=sys.stderr)
         return 1

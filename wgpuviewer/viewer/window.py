@@ -46,6 +46,9 @@ class Window:
         self.context = self.canvas.get_wgpu_context()
         self.format = self.context.get_preferred_format(gpu.adapter)
         self._windowed = ((100, 100), size)  # where leaving fullscreen puts the window
+        self._closing = False
+        self._closing_handlers = []
+        self.canvas.add_event_handler(self._on_canvas_close, "close")
         self._configure()
 
     def _configure(self):
@@ -75,11 +78,42 @@ class Window:
         self._loop.run()
 
     def close(self) -> None:
-        self.canvas.close()
+        """Close the window from the event loop, once the draw or toolkit callback under way has returned: closing
+        destroys the native window, and glfw crashes when that happens inside its own event dispatch (it draws
+        frames from a resize callback). ``closed`` is True from this call on."""
+        if not self.closed:
+            self._start_closing()
+            self._loop.call_soon(self.canvas.close)
 
     @property
     def closed(self) -> bool:
-        return self.canvas.get_closed()
+        """Closed, or about to close (``close``, the window manager's close button): no frame may be drawn."""
+        return self._closing or self.canvas.get_closed()
+
+    def on_closing(self, handler) -> None:
+        """Call ``handler()`` once, when the window starts closing (``close``, the window manager, the loop
+        stopping), before ``closed`` turns True."""
+        self._closing_handlers.append(handler)
+
+    def _start_closing(self) -> None:
+        if not self._closing:
+            for handler in self._closing_handlers:
+                handler()
+            self._closing = True
+
+    def _on_canvas_close(self, event) -> None:
+        # rendercanvas sends "close" after unconfiguring the surface and before destroying the native window.
+        self._start_closing()
+        self._release_surface()
+
+    def _release_surface(self) -> None:
+        # The wgpu surface belongs to the native window. Left to the garbage collector (the viewer's objects form
+        # cycles) it is released during interpreter exit, in no set order with the device, the instance and the
+        # display it depends on, and wgpuSurfaceRelease can crash there. Released here, everything it needs is alive.
+        inner = getattr(self.context, "_wgpu_context", None)
+        release = getattr(inner, "_release", None)
+        if release is not None:
+            release()
 
     def set_vsync(self, on: bool) -> str | None:
         """Vsync picks the surface present mode (fifo vs immediate/mailbox); it needs a reconfigure. Returns why it
