@@ -25,8 +25,8 @@ import numpy as np
 
 from wgpuviewer.core.errors import UserError
 
-#: Largest plain volume (W * H * slices) generated: 2^23 voxels = 32 MiB of float32 (e.g. 512x512x32).
-MAX_VOXELS = 1 << 23
+#: Largest plain volume (W * H * slices) generated: 2^26 voxels = 256 MiB of float32 (2048x2048x16).
+MAX_VOXELS = 1 << 26
 #: Subtracted from every stored distance (texels): covers float32 rounding of the build and of the tracer's arithmetic.
 STORE_MARGIN = 1e-3
 #: Every voxel box is grown by this much (texels) on each side: a tracer's float32 position a hair outside the box

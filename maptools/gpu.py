@@ -37,14 +37,16 @@ PARAMS = {
         ("step", "f32")]),  # f32(1 / (levels - 1)), as numpy computes it
     "maxmip.wgsl": Struct("Params", [("src_size", "vec2u"), ("dst_size", "vec2u")]),  # (w, h) of child, parent
     "distance.wgsl": Struct("Params", [
-        ("width", "u32"), ("height", "u32"), ("slices", "u32"), ("subcells", "u32"),  # subcells: K
+        ("width", "u32"), ("height", "u32"),
+        ("first_slice", "u32"), ("slices", "u32"),  # the slab baked: slices [first_slice, first_slice + slices)
+        ("subcells", "u32"),  # K
         ("sw", "f32"),  # S * W: metric length of the whole depth range t in [0, 1]
         ("sy", "f32"),  # W / H: metric height of one texel row
         ("dz", "f32"),  # metric thickness of one slice
         ("grow", "f32"),  # every voxel box is grown by this on each side (maptools.distance.BOX_GROW)
         ("margin", "f32")]),  # subtracted from every stored distance
     "distance_refined.wgsl": Struct("Params", [
-        ("width", "u32"), ("height", "u32"), ("slices", "u32"), ("subcells", "u32"),
+        ("width", "u32"), ("height", "u32"), ("first_slice", "u32"), ("slices", "u32"), ("subcells", "u32"),
         ("count", "u32"),  # columns in the list
         ("levels", "u32"),  # window levels (window_tops)
         ("bands", "u32"),  # polar bands written (1 to 4), one per vec4 lane of:
@@ -188,54 +190,103 @@ def maxmip(g: MapGpu, height: np.ndarray):
 
 
 # -- 3D distance maps ------------------------------------------------------------------------------------
+# The volumes are baked in slabs of consecutive slices (each slab's buffers within the adapter's storage limit):
+# the sub-cell tops, the window tops and the column lists are made once, the passes run slab by slab, and each
+# slab is read back into the whole volume. A slab's kernels offset their slice index by ``first_slice``.
 
-def _check_volume(g: MapGpu, w: int, h: int, slices: int, subcells: int, volumes: int = 1) -> None:
-    g.check_size(h, w)
-    need = w * h * slices * 4 * volumes
-    rows = w * h * subcells * slices * 4  # the plain map's row pass keeps every sub-cell row
-    g.compute.check_buffer(max(need, rows), f"a {w}x{h}x{slices} volume with {subcells}x{subcells} sub-cells",
-                           f"use fewer --slices or --subcells, or {FIX}")
+def bake_buffers(w: int, h: int, subcells: int, lanes: int = 0) -> tuple[int, int]:
+    """(bytes of the buffers made once, bytes per slice of a slab) of a w x h volume bake with K = ``subcells``:
+    the sub-cell tops (K^2 floats a texel) once; per slice the row pass (K floats a texel), the volume, and for
+    the refined bake ``lanes`` band volumes. Each is one storage buffer, so each must fit the binding limit."""
+    once = w * h * subcells * subcells * 4
+    per_slice = w * h * 4 * max(subcells, lanes, 1)
+    return once, per_slice
 
 
-def _plain_volume(g: MapGpu, enc, src, w: int, h: int, slices: int, height_scale: float, subcells: int, label: str):
-    """Encode tops + pass_x + pass_y of distance.wgsl; returns (stored plain volume, sub-cell tops)."""
+def fitting_subcells(w: int, h: int, max_buffer: int, lanes: int = 0, most: int = 4) -> int | None:
+    """The largest sub-cell count (of ``distance.SUBCELLS``, at most ``most``) whose bake of a w x h volume fits
+    storage buffers of ``max_buffer`` bytes with slabs of one slice; None when none does."""
     from . import distance as dist
 
+    for k in sorted((k for k in dist.SUBCELLS if k <= most), reverse=True):
+        if max(bake_buffers(w, h, k, lanes)) <= max_buffer:
+            return k
+    return None
+
+
+def _slab_slices(g: MapGpu, w: int, h: int, slices: int, subcells: int, lanes: int = 0) -> int:
+    """Slices per slab: as many as the storage limit allows (all of them when the volume fits whole)."""
+    once, per_slice = bake_buffers(w, h, subcells, lanes)
+    what = f"a {w}x{h} volume with {subcells}x{subcells} sub-cells"
+    fix = f"use fewer --subcells, downscale the height map or {FIX}"
+    g.compute.check_buffer(once, f"{what} (its sub-cell tops)", fix)
+    g.compute.check_buffer(per_slice, f"{what} (one slice)", fix)
+    return max(1, min(slices, g.compute.max_buffer // per_slice))
+
+
+def _slabs(slices: int, slab: int) -> list[tuple[int, int]]:
+    """(first slice, slice count) of each slab."""
+    return [(k0, min(slab, slices - k0)) for k0 in range(0, slices, slab)]
+
+
+def _distance_params(w: int, h: int, first: int, count: int, height_scale: float, subcells: int, slices: int) -> dict:
+    from . import distance as dist
+
+    return {"width": w, "height": h, "first_slice": first, "slices": count, "subcells": subcells,
+            "sw": height_scale * w, "sy": w / h, "dz": height_scale * w / slices, "grow": dist.BOX_GROW,
+            "margin": dist.STORE_MARGIN}
+
+
+def _subcell_tops(g: MapGpu, src, w: int, h: int, height_scale: float, subcells: int, label: str):
+    """The sub-cell tops buffer (distance.wgsl ``tops``), computed and submitted."""
     k = subcells
-    params = g.uniform("distance.wgsl", {
-        "width": w, "height": h, "slices": slices, "subcells": k, "sw": height_scale * w, "sy": w / h,
-        "dz": height_scale * w / slices, "grow": dist.BOX_GROW, "margin": dist.STORE_MARGIN})
     tops = g.storage(w * h * k * k * 4, f"maptools {label} sub-cell tops")
-    rows = g.storage(w * h * k * slices * 4, f"maptools {label} row pass")
-    out = g.storage(w * h * slices * 4, f"maptools {label} volume")
+    params = g.uniform("distance.wgsl", _distance_params(w, h, 0, 1, height_scale, k, 1))
+    enc = g.encoder(f"maptools {label} tops")
     g.dispatch(enc, "distance.wgsl", "tops", {0: params, 1: src, 2: tops}, w * k, h * k, 1)
-    g.dispatch(enc, "distance.wgsl", "pass_x", {0: params, 1: tops, 2: rows}, w, h * k, slices)
-    g.dispatch(enc, "distance.wgsl", "pass_y", {0: params, 1: rows, 2: out}, w, h, slices)
-    return out, tops
+    g.submit(enc)
+    return tops
+
+
+def _plain_slab(g: MapGpu, enc, tops, rows, out, w: int, h: int, first: int, count: int, slices: int,
+                height_scale: float, subcells: int) -> None:
+    """Encode pass_x + pass_y of distance.wgsl for slices [first, first + count) into ``out`` (the slab's
+    stored plain values, indexed (slice - first, row, column))."""
+    params = g.uniform("distance.wgsl", _distance_params(w, h, first, count, height_scale, subcells, slices))
+    g.dispatch(enc, "distance.wgsl", "pass_x", {0: params, 1: tops, 2: rows}, w, h * subcells, count)
+    g.dispatch(enc, "distance.wgsl", "pass_y", {0: params, 1: rows, 2: out}, w, h, count)
 
 
 @_guard("distance.wgsl")
 def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05, subcells: int = 4):
-    """GPU twin of distance.distance (distance.wgsl)."""
+    """GPU twin of distance.distance (distance.wgsl), baked in slabs of slices."""
     from . import distance as dist
 
     h, w = height.shape
     dist.check_volume(w, h, slices)
     dist.check_subcells(subcells, "distance")
-    _check_volume(g, w, h, slices, subcells)
+    g.check_size(h, w)
+    slab = _slab_slices(g, w, h, slices, subcells)
     src = g.storage(height, "maptools distance src")
-    enc = g.encoder("maptools distance")
-    out, _ = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance")
-    g.submit(enc)
-    return g.read(out, w * h * slices).reshape(slices, h, w)
+    tops = _subcell_tops(g, src, w, h, height_scale, subcells, "distance")
+    rows = g.storage(w * h * subcells * slab * 4, "maptools distance row pass")
+    vol = g.storage(w * h * slab * 4, "maptools distance volume")
+    out = np.empty((slices, h, w), np.float32)
+    for first, count in _slabs(slices, slab):
+        enc = g.encoder("maptools distance slab")
+        _plain_slab(g, enc, tops, rows, vol, w, h, first, count, slices, height_scale, subcells)
+        g.submit(enc)
+        out[first:first + count] = g.read(vol, w * h * count).reshape(count, h, w)
+    return out
 
 
 @_guard("distance.wgsl", "distance_refined.wgsl")
 def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05,
                      subcells: int = 4, max_angle: float = 85.0, sectors: int = 4, bands: int = 8,
                      reach: float = 16.0, progress: bool = True):
-    """GPU twin of refined.distance_refined: the plain volume (distance.wgsl), then one dispatch of
-    distance_refined.wgsl per direction bin, each read back and rounded down to float16."""
+    """GPU twin of refined.distance_refined, baked in slabs of slices: per slab the plain volume (distance.wgsl),
+    then one dispatch of distance_refined.wgsl per azimuth sector and group of up to 4 bands, each read back and
+    rounded down to float16."""
     from tqdm import tqdm
 
     from . import distance as dist
@@ -244,41 +295,52 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
     h, w = height.shape
     rf.check(w, h, slices, sectors, bands)
     dist.check_subcells(subcells, "distance_refined")
-    _check_volume(g, w, h, slices, subcells, min(bands, rf.BANDS_PER_PASS))
-    src = g.storage(height, "maptools distance_refined src")
-    enc = g.encoder("maptools distance_refined plain")
-    plain, sub_tops = _plain_volume(g, enc, src, w, h, slices, height_scale, subcells, "distance_refined")
-    g.submit(enc)
+    g.check_size(h, w)
+    lanes = min(bands, rf.BANDS_PER_PASS)
+    slab = _slab_slices(g, w, h, slices, subcells, lanes)
     directions = rf.bins(sectors, bands, max_angle)
     lists = [rf.entries(directions[s], subcells, w / h, reach) for s in range(sectors)]  # band independent
     levels = max(e.levels for e in lists)
-    n = w * h * slices
-    out = np.empty((len(directions) + 1, slices, h, w), np.float16)
-    lanes = min(bands, rf.BANDS_PER_PASS)
-    vol = g.storage(lanes * n * 4, "maptools distance_refined band volumes")
+    g.compute.check_buffer(levels * w * h * 4, f"the window tops of a {w}x{h} height map",
+                           f"downscale the height map or {FIX}")
+    src = g.storage(height, "maptools distance_refined src")
+    tops = _subcell_tops(g, src, w, h, height_scale, subcells, "distance_refined")
+    rows = g.storage(w * h * subcells * slab * 4, "maptools distance_refined row pass")
+    plain = g.storage(w * h * slab * 4, "maptools distance_refined plain slab")
+    vol = g.storage(lanes * w * h * slab * 4, "maptools distance_refined band volumes")
     windows = g.storage(levels * w * h * 4, "maptools distance_refined window tops")
-    passes = [(s, b0) for s in range(sectors) for b0 in range(0, bands, rf.BANDS_PER_PASS)]
-    for number, (sector, b0) in enumerate(tqdm(passes, desc="distance_refined (gpu)", unit="pass",
-                                               disable=None if progress else True, leave=False)):
+    columns = [g.storage(e.packed(w, h, subcells), "maptools distance_refined columns") for e in lists]
+    out = np.empty((len(directions) + 1, slices, h, w), np.float16)
+    groups = [(s, b0) for s in range(sectors) for b0 in range(0, bands, rf.BANDS_PER_PASS)]
+    passes = [(slab_, group) for slab_ in _slabs(slices, slab) for group in groups]
+    windows_done = False
+    for (first, count), (sector, b0) in tqdm(passes, desc="distance_refined (gpu)", unit="pass",
+                                              disable=None if progress else True, leave=False):
+        n = w * h * count
         group = [directions[b * sectors + sector] for b in range(b0, min(b0 + rf.BANDS_PER_PASS, bands))]
         lane = [0.0] * (4 - len(group))  # bands of the group, one per vec4 lane; unused lanes 0
         p = g.uniform("distance_refined.wgsl", {
-            "width": w, "height": h, "slices": slices, "subcells": subcells, "count": len(lists[sector].rho),
-            "levels": levels, "bands": len(group), "tan_lo": [d.tan_lo for d in group] + lane,
-            "cot_hi": [d.cot_hi for d in group] + lane, "inv_sin_hi": [1.0 / d.sin_hi for d in group] + lane,
-            "cap": [reach / d.sin_hi for d in group] + lane, "dz": height_scale * w / slices,
-            "grow": dist.BOX_GROW, "margin": dist.STORE_MARGIN, "sw": height_scale * w})
-        cbuf = g.storage(lists[sector].packed(w, h, subcells), "maptools distance_refined columns")
+            "width": w, "height": h, "first_slice": first, "slices": count, "subcells": subcells,
+            "count": len(lists[sector].rho), "levels": levels, "bands": len(group),
+            "tan_lo": [d.tan_lo for d in group] + lane, "cot_hi": [d.cot_hi for d in group] + lane,
+            "inv_sin_hi": [1.0 / d.sin_hi for d in group] + lane, "cap": [reach / d.sin_hi for d in group] + lane,
+            "dz": height_scale * w / slices, "grow": dist.BOX_GROW, "margin": dist.STORE_MARGIN,
+            "sw": height_scale * w})
         enc = g.encoder("maptools distance_refined pass")
-        if number == 0:
+        if not windows_done:
             g.dispatch(enc, "distance_refined.wgsl", "window_tops", {0: p, 1: src, 2: windows}, w, h, levels)
+            windows_done = True
+        if (sector, b0) == groups[0]:  # the slab's plain values, which every pass of the slab floors at
+            _plain_slab(g, enc, tops, rows, plain, w, h, first, count, slices, height_scale, subcells)
         g.dispatch(enc, "distance_refined.wgsl", "main",
-                   {0: p, 1: plain, 2: vol, 3: sub_tops, 4: windows, 5: cbuf}, w, h, slices)
+                   {0: p, 1: plain, 2: vol, 3: tops, 4: windows, 5: columns[sector]}, w, h, count)
         g.submit(enc)
+        if (sector, b0) == groups[0]:
+            stored = dist.round_down(g.read(plain, n).astype(np.float64), np.float16)
+            out[-1, first:first + count] = stored.reshape(count, h, w)
         result = dist.round_down(g.read(vol, len(group) * n).astype(np.float64), np.float16)
         for i, b in enumerate(range(b0, b0 + len(group))):
-            out[b * sectors + sector] = result[i * n:(i + 1) * n].reshape(slices, h, w)
-    out[-1] = dist.round_down(g.read(plain, n).astype(np.float64), np.float16).reshape(slices, h, w)
+            out[b * sectors + sector, first:first + count] = result[i * n:(i + 1) * n].reshape(count, h, w)
     return out
 
 

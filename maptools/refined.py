@@ -34,8 +34,10 @@ from wgpuviewer.core.errors import UserError
 
 from . import distance as dist
 
-#: Total values (volumes x slices x W x H) the refined kind generates: 2^28 (512 MiB of float16).
-MAX_VALUES = 1 << 28
+#: Total values (volumes x slices x W x H) the refined kind generates: the default 33 volumes (4 x 8 bins and the
+#: plain one) of a 1024^2 map at 16 slices, 1056 MiB of float16. Memory, not speed, is what larger maps would buy:
+#: fewer slices cost more fetches than the bins save (docs/maps.md, "Large height maps").
+MAX_VALUES = 33 << 24
 #: Bins are widened by this much (radians) in azimuth and polar angle: a float32 tracer that rounds a ray across a
 #: bin edge still reads a value that holds for it.
 ANGLE_SLACK = 1e-4

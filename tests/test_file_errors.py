@@ -98,21 +98,6 @@ def test_a_height_map_too_large_for_a_derived_map_is_reported_against_the_height
                            "be built:"), line
     assert f"3D limit of {limit}" in line
 
-
-def test_a_height_map_too_large_for_a_derived_map_names_what_the_scene_can_change(files, capsys, gpu, monkeypatch):
-    """Refused from the file's header before the file is decoded; the hint is the height map's size, not maptools'
-    --slices, which a scene does not have."""
-    cv2.imwrite(str(files / "big.png"), np.full((800, 1000), 128, np.uint8))
-    path = scene_file(files, height="big.png")
-    monkeypatch.setattr(textures, "read_height", lambda *a, **k: pytest.fail("the height file was decoded"))
-    assert cli.main(["render", str(path), "-o", str(files / "x.png"), "--size", "16x16",
-                     "--technique", "distance"]) == 2
-    line = one_line(capsys)
-    assert line.startswith(f"wgpuviewer: error: {path}: materials.m.height = 'big.png': its distance map cannot be "
-                           "built: distance: a 1000x800x16 volume holds 12800000 values"), line
-    assert line.endswith("use a height map of at most 524288 texels (e.g. 809x647)") and "--" not in line, line
-
-
 def test_a_byte_order_mark_gets_a_hint(files):
     path = scene_file(files)
     path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())

@@ -11,12 +11,13 @@ import numpy as np
 import pytest
 
 import maptools
-from maptools import cli
+from maptools import cli, gpu
 from maptools import distance as dist
 from maptools import refined as rf
 from maptools.registry import KINDS
 from maptools.trace import sphere_trace
 from tests.maptools.helpers import adversarial_maps, smooth_tileable
+from wgpuviewer.core.compute import Compute
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.relief.reference import exact_hit, sample_bilinear, view_dir_from_angles
 
@@ -391,6 +392,45 @@ def test_gpu_matches_cpu(name, s, slices, extra):
         assert c.ok, (kind, name, opts, c)
 
 
+@pytest.mark.requires_gpu
+def test_gpu_bakes_in_slabs_where_the_volume_is_beyond_the_storage_limit(monkeypatch):
+    """A storage limit of two slices' buffers: the bakes run slab by slab (slices offset by first_slice) and give the
+    volumes of the whole bake, value for value, which match the CPU references."""
+    h = MAPS["smooth_40x24"]
+    opts = {"slices": 5, "height_scale": 0.3, "subcells": 2}
+    refined = {**opts, "sectors": 2, "bands": 6}
+    whole = gpu.distance(h, **opts), gpu.distance_refined(h, progress=False, **refined)
+    _, per_slice = gpu.bake_buffers(40, 24, 2, rf.BANDS_PER_PASS)
+    monkeypatch.setattr(Compute, "max_buffer", property(lambda self: 2 * per_slice))
+    assert gpu._slab_slices(gpu.runner(), 40, 24, 5, 2, rf.BANDS_PER_PASS) == 2  # slabs of 2, 2 and 1 slices
+    slabs = gpu.distance(h, **opts), gpu.distance_refined(h, progress=False, **refined)
+    assert np.array_equal(slabs[0], whole[0]) and np.array_equal(slabs[1], whole[1])
+    for kind, options, result in (("distance", opts, slabs[0]), ("distance_refined", refined, slabs[1])):
+        c = KINDS[kind].compare(maptools.generate(kind, h, backend="cpu", **options), result,
+                                KINDS[kind].resolve(options))
+        assert c.ok, (kind, c)
+
+
+def test_fitting_subcells_follow_the_storage_limit():
+    once, per_slice = gpu.bake_buffers(100, 50, 4)
+    assert (once, per_slice) == (100 * 50 * 16 * 4, 100 * 50 * 4 * 4)
+    assert gpu.bake_buffers(100, 50, 1, rf.BANDS_PER_PASS) == (100 * 50 * 4, 100 * 50 * 4 * rf.BANDS_PER_PASS)
+    assert gpu.fitting_subcells(100, 50, once) == 4
+    assert gpu.fitting_subcells(100, 50, once - 1) == 2
+    assert gpu.fitting_subcells(100, 50, once, most=2) == 2
+    assert gpu.fitting_subcells(100, 50, 100 * 50 * 4) == 1
+    assert gpu.fitting_subcells(100, 50, 100 * 50 * 4, lanes=rf.BANDS_PER_PASS) is None
+
+
+@pytest.mark.requires_gpu
+def test_a_bake_whose_single_slice_does_not_fit_names_maptools_options(monkeypatch):
+    monkeypatch.setattr(Compute, "max_buffer", property(lambda self: 20000))  # the map and one slice: yes
+    with pytest.raises(UserError, match=r"a 40x24 volume with 4x4 sub-cells \(its sub-cell tops\) needs a 61440-byte "
+                                        r"buffer, .*; use fewer --subcells, downscale the height map or use --backend "
+                                        r"cpu$"):
+        maptools.generate("distance", MAPS["smooth_40x24"], backend="gpu")
+
+
 # -- options, limits, CLI -----------------------------------------------------------------------------
 
 @pytest.mark.parametrize("kind,bad,needle", [
@@ -408,11 +448,23 @@ def test_bad_options(kind, bad, needle):
 
 
 def test_volume_limits():
-    with pytest.raises(UserError, match="more than the limit"):
-        maptools.generate("distance", np.zeros((1024, 1024), np.float32), backend="cpu", slices=16)
-    with pytest.raises(UserError, match="float16"):
-        maptools.generate("distance_refined", np.zeros((512, 512), np.float32), backend="cpu", slices=32,
+    """Refused from the sizes alone, before any work (the CPU reference at these sizes would take hours)."""
+    assert dist.MAX_VOXELS == 2048 * 2048 * 16  # a 2K map's plain volume at the default slices
+    with pytest.raises(UserError, match=r"a 2048x2048x17 volume holds 71303168 values, more than the limit 67108864 "
+                                        r"\(float32\); downscale the height map or use fewer --slices$"):
+        maptools.generate("distance", np.zeros((2048, 2048), np.float32), backend="cpu", slices=17)
+    with pytest.raises(UserError, match=r"49 volumes of 512x512x128 hold .* \(float16\); downscale the height map "
+                                        r"or use fewer --slices, --sectors or --bands$"):
+        maptools.generate("distance_refined", np.zeros((512, 512), np.float32), backend="cpu", slices=128,
                           sectors=16, bands=3)
+    with pytest.raises(UserError, match=r"^distance_refined: 33 volumes of 2048x2048x16 hold 2214592512 values, more "
+                                        r"than the limit 553648128 \(float16\); downscale the height map or use fewer "
+                                        r"--slices, --sectors or --bands$"):  # the default bins at 2K
+        maptools.generate("distance_refined", np.zeros((2048, 2048), np.float32), backend="cpu")
+    with pytest.raises(UserError, match=r"^distance_refined: a 2048x2048x17 volume holds .*; downscale the height map "
+                                        r"or use fewer --slices$"):  # few volumes: the plain volume is the limit
+        maptools.generate("distance_refined", np.zeros((2048, 2048), np.float32), backend="cpu", slices=17,
+                          sectors=1, bands=1)
 
 
 def test_cli_generate_distance(tmp_path):

@@ -6,19 +6,19 @@ key and the memory it needed. Hints name only what the user can change where the
 from __future__ import annotations
 
 import dataclasses
+import re
 
-import cv2
 import numpy as np
 import pytest
 import wgpu
 
-import maptools
 from tests.relief.scenes import material_scene
 from wgpuviewer import cli, textures
 from wgpuviewer.core import gpu as core_gpu
 from wgpuviewer.core.compute import Compute
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.relief.renderer import Renderer
+from wgpuviewer.core.gpu import format_bytes
+from wgpuviewer.relief.renderer import Renderer, frame_bytes
 from wgpuviewer.scene import parse_scene
 
 
@@ -120,12 +120,14 @@ def test_a_frame_beyond_the_largest_buffer_is_refused_before_any_map_is_built(gp
 def test_a_frame_the_adapter_cannot_allocate_names_the_size_and_the_memory(gpu, error, capsys, tmp_path, monkeypatch):
     failing = other_gpu(gpu, fail="offscreen:data", error=error)
     s = parse_scene(scene("'builtin:flat0'", ("basic",)))
-    with pytest.raises(UserError, match=r"^render size 40x30 needs 51.6 KiB of GPU memory, more than .* could "
+    need = re.escape(format_bytes(frame_bytes((40, 30))))  # every offscreen target and the depth attachment
+    with pytest.raises(UserError, match=rf"^render size 40x30 needs {need} of GPU memory, more than .* could "
                                         r"allocate; use a smaller size$"):
         Renderer(s, failing).render("basic", (40, 30))
     monkeypatch.setattr(core_gpu, "get_gpu", lambda *a, **k: failing)
     assert cli.main(["render", "-o", str(tmp_path / "x.png"), "--size", "40x30", "--technique", "basic"]) == 2
-    assert one_line(capsys).startswith("wgpuviewer: error: --size 40x30 needs 51.6 KiB of GPU memory")
+    assert one_line(capsys).startswith(f"wgpuviewer: error: --size 40x30 needs {format_bytes(frame_bytes((40, 30)))} "
+                                       "of GPU memory")
 
 
 def test_other_wgpu_errors_stay_internal_errors(gpu):
@@ -160,36 +162,6 @@ def test_core_texture_creation_reports_memory_in_one_line(gpu):
                                         r"smaller texture$"):
         core_gpu.create_texture(failing, [base], "rgba32float", "huge")
 
-
-@pytest.mark.parametrize("size", [1024, 4096])
-def test_a_refined_distance_map_too_large_is_refused_from_the_builtins_size_without_generating_it(
-        gpu, size, no_builtins):
-    """The QA case: 4096^2 was refused only after generating the builtin; 1024^2 suggested --slices, which scenes do
-    not have, and quoted the plain volume's limit."""
-    s = parse_scene(scene(f"{{ builtin = 'bricks', size = [{size}, {size}] }}", ("distance_refined",)))
-    with pytest.raises(UserError) as error:
-        Renderer(s, gpu).prepare("distance_refined")
-    text = str(error.value)
-    assert text.startswith(f"<scene>: materials.m.height = {{'builtin': 'bricks', 'size': [{size}, {size}]}}: its "
-                           f"distance_refined map cannot be built: distance_refined: 33 volumes of {size}x{size}x16 "
-                           "hold"), text
-    assert "more than the limit 268435456 (float16); use a height map of at most 508400 texels (e.g. 713x713)" in text
-    assert "--" not in text
-
-
-def test_a_height_file_too_large_for_a_map_is_refused_from_its_header_without_loading_it(gpu, tmp_path, monkeypatch):
-    cv2.imwrite(str(tmp_path / "h.png"), np.full((800, 1000), 128, np.uint8))
-    (tmp_path / "s.toml").write_text(scene("'h.png'", ("distance",)))
-    textures.clear_cache()
-    monkeypatch.setattr(textures, "read_height", lambda *a, **k: pytest.fail("the height file was decoded"))
-    s = parse_scene((tmp_path / "s.toml").read_text(), tmp_path / "s.toml")
-    with pytest.raises(UserError, match=r"materials.m.height = 'h.png': its distance map cannot be built: distance: a "
-                                        r"1000x800x16 volume holds 12800000 values, more than the limit 8388608 "
-                                        r"\(float32\); use a height map of at most 524288 texels \(e.g. 809x647\)$"):
-        Renderer(s, gpu).prepare("distance")
-    textures.clear_cache()
-
-
 def test_a_pyramid_atlas_beyond_the_2d_limit_names_the_tallest_map_that_fits(gpu, no_builtins):
     small = other_gpu(gpu, limits={"max-texture-dimension-2d": 64})
     s = parse_scene(scene("{ builtin = 'bumps', size = [48, 48] }", ("maxmip",)))
@@ -210,13 +182,3 @@ def test_2d_maps_beyond_the_gpu_kernels_buffers_are_built_on_the_cpu(gpu, tmp_pa
 
 
 # --- maptools names its own options -------------------------------------------------------------------------------
-
-
-def test_maptools_quotes_the_refined_kinds_own_limit_and_options():
-    with pytest.raises(UserError, match=r"^distance_refined: 33 volumes of 1024x1024x16 hold 553648128 values, more "
-                                        r"than the limit 268435456 \(float16\); downscale the height map or use fewer "
-                                        r"--slices, --sectors or --bands$"):
-        maptools.generate("distance_refined", np.zeros((1024, 1024), np.float32), backend="cpu")
-    with pytest.raises(UserError, match=r"a 1024x1024x16 volume holds .*; downscale the height map or use fewer "
-                                        r"--slices$"):  # few volumes: the plain volume is the limit
-        maptools.generate("distance_refined", np.zeros((1024, 1024), np.float32), backend="cpu", sectors=1, bands=1)

@@ -9,11 +9,14 @@ never from a private copy.
 
 A derived slot's ``check`` refuses a height map too large for the map on this adapter from its size alone (the
 renderer calls it with a file's header size before loading or generating anything; ``build`` calls it too), naming
-what exceeds which limit and the size of height map that fits: a scene has no map options to change.
+what exceeds which limit and the size of height map that fits: a scene has no map options to change. The distance
+volumes choose their own options instead (``volume_plan``): the default depth slices and sub-cells where they fit,
+else the most that do, said in one warning line when the map is built; refused only below the fewest slices.
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -22,15 +25,18 @@ import wgpu
 
 from maptools import cone as cone_kind
 from maptools import distance as distance_kind
+from maptools import gpu as map_gpu
 from maptools import refined as refined_kind
 from maptools.cache import cached_generate
 from maptools.cpu import level_sizes
 from wgpuviewer.core.compute import compute_for
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.gpu import Gpu, allocating, check_texture_size, create_texture, mip_chain
+from wgpuviewer.core.gpu import Gpu, allocating, check_texture_size, create_texture, format_bytes, mip_chain
 
 from . import autotable
 from .techniques import CONE_FILTER, CONE_MAX_RATIO, REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -124,25 +130,111 @@ def _check_quadmax(gpu: Gpu, w: int, h: int) -> None:
     _check_atlas(gpu, w, h, lambda rows: max(1, _atlas_rows(level_sizes(rows, 1)[1:])), "quadmax")
 
 
-def _check_volume_size(gpu: Gpu, w: int, h: int, depth: int, what: str) -> None:
+#: Depth slices and sub-cells per cell side of the distance volumes where they fit (maptools' defaults).
+DISTANCE_SLICES = 16
+DISTANCE_SUBCELLS = 4
+#: Fewest depth slices a volume is reduced to; a height map that does not fit even so is refused. Fewer slices stay
+#: exact but cost fetches (docs/maps.md, "Large height maps"): a slice spans S*W/Dz texels of depth.
+MIN_SLICES = 4
+#: A refined map of at most this many slices saves no fetches over the plain map at 16 (measured at 1K and 2K:
+#: docs/maps.md, "Large height maps"): where that is all that fits, the one line says so.
+REFINED_PAYS_SLICES = DISTANCE_SLICES // 2
+
+
+@dataclass(frozen=True)
+class VolumePlan:
+    """How a distance slot's volume is built from a W x H height map on this adapter: its depth slices and
+    sub-cells, the largest (up to the defaults) that fit the adapter's and maptools' limits, and what made them
+    smaller (``reduced``: one clause per reduction; empty: the defaults)."""
+
+    kind: str
+    width: int
+    height: int
+    slices: int
+    subcells: int
+    reduced: tuple[str, ...] = ()
+    #: A better choice where the user is, or "" (a refined map with few slices: the plain one at more slices).
+    advice: str = ""
+
+    @property
+    def volumes(self) -> int:
+        return REFINED_SECTORS * REFINED_BANDS + 1 if self.kind == "distance_refined" else 1
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes of the texture: float16 refined volumes, a float32 plain one."""
+        return self.width * self.height * self.slices * self.volumes * (2 if self.kind == "distance_refined" else 4)
+
+    def note(self, label: str) -> str:
+        """The one line saying what was chosen and why (for a reduced plan)."""
+        return (f"{label}: a {self.width}x{self.height} height map gets {'; '.join(self.reduced)}; "
+                f"{format_bytes(self.nbytes)}; the tracer stays exact, at more fetches per ray"
+                f"{'; ' + self.advice if self.advice else ''} (docs/maps.md)")
+
+
+def volume_plan(gpu: Gpu, kind: str, w: int, h: int) -> VolumePlan:
+    """The settings a w x h height map's ``kind`` volume (distance, distance_refined) is built with here: the
+    defaults, else the most slices (down to MIN_SLICES) and sub-cells within the adapter's 3D texture limit,
+    maptools' volume limits and the adapter's storage buffers (the bake binds the sub-cell tops whole); a
+    UserError naming what the scene can change when even the fewest do not fit."""
+    refined = kind == "distance_refined"
+    volumes = REFINED_SECTORS * REFINED_BANDS + 1 if refined else 1
     side = gpu.device.limits["max-texture-dimension-3d"]
-    if max(w, h, depth) > side:
-        raise UserError(f"{what}: volume of {w}x{h}x{depth} exceeds this adapter's 3D limit of {side} texels per "
-                        f"side; use a height map of at most {side} texels per side")
+    if max(w, h) > side:
+        raise UserError(f"{kind}: a volume of {w}x{h} texels per slice exceeds this adapter's 3D limit of {side} "
+                        f"texels per side; use a height map of at most {side} texels per side")
+
+    def layers(n: int) -> str:
+        return f"{volumes} x {n} slices stack {volumes * n} layers, more than this adapter's 3D limit of {side} texels"
+
+    def values(limit: int, unit: str, per_volume: int) -> Callable[[int], str]:
+        held = f"{per_volume} volumes of {w}x{h}x{{}} hold" if per_volume > 1 else f"a {w}x{h}x{{}} volume holds"
+        return lambda n: (f"{held.format(n)} {per_volume * n * w * h} values, more than maptools' limit of {limit} "
+                          f"({unit})")
+
+    # (most slices within the limit, what n slices exceed, the fix when MIN_SLICES exceed it)
+    limits = [(side // volumes, layers, "use the technique distance")]
+    if refined:
+        limits.append((refined_kind.MAX_VALUES // (w * h * volumes),
+                       values(refined_kind.MAX_VALUES, "float16", volumes),
+                       _fits_texels(w, h, refined_kind.MAX_VALUES // (volumes * MIN_SLICES))
+                       + ", or the technique distance"))
+    limits.append((distance_kind.MAX_VOXELS // (w * h), values(distance_kind.MAX_VOXELS, "float32", 1),
+                   _fits_texels(w, h, distance_kind.MAX_VOXELS // MIN_SLICES)))
+    for most, exceeded, fix in limits:
+        if most < MIN_SLICES:
+            raise UserError(f"{kind}: even at {MIN_SLICES} depth slices (the fewest it is built with) "
+                            f"{exceeded(MIN_SLICES)}; {fix}")
+    slices = min(DISTANCE_SLICES, *(most for most, _, _ in limits))
+    reduced = [f"{slices} depth slices instead of {DISTANCE_SLICES} ({exceeded(DISTANCE_SLICES)})"
+               for most, exceeded, _ in limits if most == slices < DISTANCE_SLICES][:1]
+    max_buffer = compute_for(gpu).max_buffer
+    lanes = refined_kind.BANDS_PER_PASS if refined else 0
+    subcells = map_gpu.fitting_subcells(w, h, max_buffer, lanes, most=DISTANCE_SUBCELLS)
+    if subcells is None:
+        raise UserError(f"{kind}: baking a {w}x{h} volume needs storage buffers of "
+                        f"{format_bytes(max(map_gpu.bake_buffers(w, h, 1, lanes)))}, more than the "
+                        f"{format_bytes(max_buffer)} this adapter binds; use a smaller height map")
+    if subcells < DISTANCE_SUBCELLS:
+        need = max(map_gpu.bake_buffers(w, h, DISTANCE_SUBCELLS, lanes))
+        reduced.append(f"{subcells}x{subcells} sub-cells per cell instead of {DISTANCE_SUBCELLS}x"
+                       f"{DISTANCE_SUBCELLS} (whose bake needs a {format_bytes(need)} buffer, more than the "
+                       f"{format_bytes(max_buffer)} this adapter binds)")
+    advice = ""
+    if refined and slices <= REFINED_PAYS_SLICES:
+        plain = volume_plan(gpu, "distance", w, h)
+        if plain.slices > slices:
+            advice = (f"the technique distance ({plain.slices} slices here, {format_bytes(plain.nbytes)}) takes about "
+                      "as many fetches or fewer")
+    return VolumePlan(kind, w, h, slices, subcells, tuple(reduced), advice)
 
 
 def _check_distance(gpu: Gpu, w: int, h: int) -> None:
-    slices = DISTANCE_SLICES
-    distance_kind.check_volume(w, h, slices, "distance",
-                               fix=_fits_texels(w, h, distance_kind.MAX_VOXELS // slices))
-    _check_volume_size(gpu, w, h, slices, "distance")
+    volume_plan(gpu, "distance", w, h)
 
 
 def _check_distance_refined(gpu: Gpu, w: int, h: int) -> None:
-    slices, volumes = DISTANCE_SLICES, REFINED_SECTORS * REFINED_BANDS + 1
-    texels = min(distance_kind.MAX_VOXELS // slices, refined_kind.MAX_VALUES // (volumes * slices))
-    refined_kind.check(w, h, slices, REFINED_SECTORS, REFINED_BANDS, fix=_fits_texels(w, h, texels))
-    _check_volume_size(gpu, w, h, volumes * slices, "distance_refined")
+    volume_plan(gpu, "distance_refined", w, h)
 
 
 def _check_cone(gpu: Gpu, w: int, h: int) -> None:
@@ -289,37 +381,47 @@ def _auto_table(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str, pr
 
 def _volume_texture(gpu: Gpu, volume: np.ndarray, label: str) -> wgpu.GPUTexture:
     """A (Dz, H, W) float32 volume as an r32float 3D texture, or (V, Dz, H, W) float16 volumes stacked along the
-    depth as r16float (volume v at depths [v Dz, (v + 1) Dz))."""
+    depth as r16float (volume v at depths [v Dz, (v + 1) Dz)); uploaded one depth layer at a time (no staging
+    copy of the whole volume)."""
     half = volume.dtype == np.float16
     h, w = volume.shape[-2:]
     depth = volume.size // (w * h)
-    _check_volume_size(gpu, w, h, depth, label)
     item = 2 if half else 4
     with allocating(gpu, label, w * h * depth * item, "use a smaller height map"):
         texture = gpu.device.create_texture(
             label=label, size=(w, h, depth), dimension="3d", format="r16float" if half else "r32float",
             usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
         )
-    data = np.ascontiguousarray(volume.reshape(depth, h, w), np.float16 if half else np.float32)
-    gpu.device.queue.write_texture(
-        {"texture": texture, "mip_level": 0, "origin": (0, 0, 0)}, data,
-        {"offset": 0, "bytes_per_row": w * data.itemsize, "rows_per_image": h}, (w, h, depth),
-    )
+    layers = volume.reshape(depth, h, w)
+    for z in range(depth):
+        gpu.device.queue.write_texture(
+            {"texture": texture, "mip_level": 0, "origin": (0, 0, z)},
+            np.ascontiguousarray(layers[z], np.float16 if half else np.float32),
+            {"offset": 0, "bytes_per_row": w * item, "rows_per_image": h}, (w, h, 1),
+        )
     return texture
 
 
+def _planned(gpu: Gpu, kind: str, depth: np.ndarray, label: str) -> VolumePlan:
+    """The volume plan of a height map, its reductions said in one warning line."""
+    plan = volume_plan(gpu, kind, *_size(depth))
+    if plan.reduced:
+        log.warning(plan.note(label))
+    return plan
+
+
 def _distance(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
-    _check_distance(gpu, *_size(depth))
-    volume = cached_generate("distance", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
+    plan = _planned(gpu, "distance", depth, label)
+    volume = cached_generate("distance", 1.0 - depth, backend="auto", slices=plan.slices, subcells=plan.subcells,
                              height_scale=height_scale)
     return _volume_texture(gpu, volume, label)
 
 
 def _distance_refined(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
-    _check_distance_refined(gpu, *_size(depth))
-    volumes = cached_generate("distance_refined", 1.0 - depth, backend="auto", slices=DISTANCE_SLICES,
-                              height_scale=height_scale, max_angle=REFINED_MAX_ANGLE, sectors=REFINED_SECTORS,
-                              bands=REFINED_BANDS)
+    plan = _planned(gpu, "distance_refined", depth, label)
+    volumes = cached_generate("distance_refined", 1.0 - depth, backend="auto", slices=plan.slices,
+                              subcells=plan.subcells, height_scale=height_scale, max_angle=REFINED_MAX_ANGLE,
+                              sectors=REFINED_SECTORS, bands=REFINED_BANDS)
     return _volume_texture(gpu, volumes, label)
 
 
@@ -344,9 +446,6 @@ def _cone(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.
     packed = np.stack([np.asarray(ratios, np.float32), footprint_min_depth(depth, gpu.depth_format)], axis=-1)
     return create_texture(gpu, [packed], "rg32float", label)
 
-
-#: Depth slices of the distance volumes (maptools' default).
-DISTANCE_SLICES = 16
 
 _FILTERABLE_2D = {"texture": {"sample_type": "float", "view_dimension": "2d"}}
 _UNFILTERABLE_2D = {"texture": {"sample_type": "unfilterable-float", "view_dimension": "2d"}}

@@ -4,7 +4,8 @@
 //   pass_x:     g(i, b, k) = min over sub-cell columns a of row b: gap_u(i, a)^2 + max(top - box bottom, 0)^2
 //   pass_y:     d(i, j, k)^2 = min over sub-cell rows b: gap_v(j, b)^2 + g(i, b, k); stored max(d - margin, 0)
 // The passes walk offsets outwards in pairs of equal gap and stop once the gap alone reaches the best value: exact,
-// bounded by half a period. Volumes are f32 buffers indexed (k * rows + row) * W + i.
+// bounded by half a period. Volumes are f32 buffers indexed (k * rows + row) * W + i, k the slice within the slab
+// baked (slices [first_slice, first_slice + slices): maptools/gpu.py bakes large volumes slab by slab).
 // #include "common/map_buffers.wgsl"
 
 // Bilinear depth (repeat) at the sub-cell vertex (a, b): X = 0.5 + a / K, Y = (0.5 + b / K) * sy.
@@ -44,7 +45,7 @@ fn pass_x(@builtin(global_invocation_id) gid: vec3u) {
     let wk = i32(P.width * P.subcells);
     let hk = P.height * P.subcells;
     if (gid.x >= P.width || gid.y >= hk || gid.z >= P.slices) { return; }
-    let bottom = f32(gid.z + 1u) * P.dz + P.grow;
+    let bottom = f32(P.first_slice + gid.z + 1u) * P.dz + P.grow;
     let base = i32(gid.x * P.subcells);
     let row = gid.y * u32(wk);
     var best = 3.0e38;

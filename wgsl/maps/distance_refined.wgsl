@@ -11,7 +11,8 @@
 // cell is a header followed by its sub-cells (sorted by rho): they are looked at only when the whole cell's bound
 // can beat a band's value. Column offsets come pre-wrapped into [0, period).
 //   window_tops: per cell and level L, the top of the window of 2^(L-1) x 2^(L-1) cells (least texel depth) x S*W
-//   main:        src = the stored plain volume, dst = the bands' volumes (band, slice, row, column)
+//   main:        src = the stored plain values, dst = the bands' volumes (band, slice, row, column), both of the slab
+//                of slices [first_slice, first_slice + slices) (maptools/gpu.py bakes large volumes slab by slab)
 // #include "common/map_buffers.wgsl"
 
 struct Column {
@@ -66,7 +67,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if (gid.x >= P.width || gid.y >= P.height || gid.z >= P.slices) { return; }
     let index = (gid.z * P.height + gid.y) * P.width + gid.x;
     let plain = vec4f(src[index]);
-    let bottom = f32(gid.z + 1u) * P.dz + P.grow;
+    let bottom = f32(P.first_slice + gid.z + 1u) * P.dz + P.grow;
     // lanes past `bands` start done: their value is the cap, and nothing is written for them
     let unused = vec4<bool>(P.bands < 1u, P.bands < 2u, P.bands < 3u, P.bands < 4u);
     var best = P.cap;
