@@ -25,19 +25,19 @@ def table_of(height: np.ndarray, height_scale: float = 0.05) -> np.ndarray:
     return autotable.measure(1.0 - np.asarray(height, np.float32), height_scale, probe)
 
 
-def test_pom_layers_keep_the_horizontal_spacing_inside_a_bin():
+def test_scaled_layers_keep_the_horizontal_spacing_inside_a_bin():
     edges = autotable.edge_angles()
     for n in (4, 16, 64):
         lower = autotable.lower_edge_layers(n)
         assert lower == int(np.ceil(n / np.sqrt(2)))
         for b in range(1, len(edges) - 1):
             inside = np.linspace(edges[b], edges[b + 1], 50)[1:-1]
-            got = autotable.pom_layers(n, inside)
+            got = autotable.scaled_layers(n, inside)
             assert got.min() >= lower and got.max() <= n and (np.diff(got) >= 0).all()
             tan = np.tan(np.radians(inside))
             assert (got >= n * tan / np.tan(np.radians(edges[b + 1])) - 1e-9).all()  # never wider-spaced than at the edge
-            assert autotable.pom_layers(n, edges[b] + 1e-9) == lower
-        assert autotable.pom_layers(n, 0.0) == n and autotable.pom_layers(n, 89.9) == n  # bin 0, last bin: as is
+            assert autotable.scaled_layers(n, edges[b] + 1e-9) == lower
+        assert autotable.scaled_layers(n, 0.0) == n and autotable.scaled_layers(n, 89.9) == n  # bin 0, last bin: as is
 
 
 def test_bins_and_budget_levels():
@@ -59,6 +59,7 @@ def test_the_shader_picks_the_tables_choice_and_runs_the_candidates_code(gpu):
     angles = rng.uniform(0, 89.5, 4096)
     view = view_dir_from_angles(angles, rng.uniform(0, 360, 4096))
     uv = rng.random((4096, 2))
+    tested = set()
     for max_error in (0.25, 0.5, 2.0):
         got = probe("auto", h, uv, view, 0.05, max_error=max_error)
         choice = autotable.texels(table)[autotable.budget_level(max_error)][autotable.bin_of(angles), 0]
@@ -66,25 +67,28 @@ def test_the_shader_picks_the_tables_choice_and_runs_the_candidates_code(gpu):
         assert np.mean(got.layers == choice + 1) > 0.995, max_error
         for index in np.unique(choice):
             name, params = AUTO_CANDIDATES[int(index)]
+            tested.add(name)
             rays = got.layers == index + 1
             if name == "basic":
                 np.testing.assert_array_equal(got.uv[rays], uv[rays].astype(np.float32))
                 continue
-            if name != "pom":
+            if name not in autotable.LAYER_PARAM:
                 alone = probe(name, h, uv[rays], view[rays], 0.05, **params)
                 np.testing.assert_array_equal(got.uv[rays], alone.uv)
                 np.testing.assert_array_equal(got.fetches[rays], alone.fetches)
                 continue
-            # POM runs the count scaled with tan inside the bin (autotable.pom_layers, in float64 here)
-            layers = autotable.pom_layers(params["layers"], angles[rays])
-            assert layers.min() >= autotable.lower_edge_layers(params["layers"]) and layers.max() <= params["layers"]
+            # POM and relief run the count scaled with tan inside the bin (autotable.scaled_layers, in float64 here)
+            key = autotable.LAYER_PARAM[name]
+            layers = autotable.scaled_layers(params[key], angles[rays])
+            assert layers.min() >= autotable.lower_edge_layers(params[key]) and layers.max() <= params[key]
             same = np.zeros(rays.sum(), bool)
             for n in np.unique(layers):
                 sub = layers == n
-                alone = probe("pom", h, uv[rays][sub], view[rays][sub], 0.05, layers=int(n))
+                alone = probe(name, h, uv[rays][sub], view[rays][sub], 0.05, **{**params, key: int(n)})
                 same[sub] = (got.uv[rays][sub] == alone.uv).all(axis=1) & (got.fetches[rays][sub] == alone.fetches)
             # float32 tan may round a ray sitting on a count's boundary to the neighbouring count
             assert same.mean() > 0.995, (max_error, params, same.mean())
+    assert tested == set(autotable.COST_WEIGHTS), tested  # every method's code ran
 
 
 BUDGET_MAPS = ("bricks", "bumps", "ridges", "flat0", "flat1", "spike", "step", "wall", "checker")

@@ -100,18 +100,23 @@ def test_pom_adaptive_is_pom_with_its_layer_count(gpu):
 # --- relief ------------------------------------------------------------------------------------------------
 
 def test_relief_binary_steps_shrink_the_error(gpu):
+    """The secant finish (common/binary.wgsl) is second order: each halving of the bracket cuts the p95 about
+    fourfold (a midpoint finish: twofold) down to float32's floor, and the hit stays within the final bracket, one
+    linear step / 2^binary_steps. The finish against the midpoint: tests/relief/test_relief_finish.py."""
     h = height_map("bumps", (128, 128))
-    errors = [measure("relief", h, 60, rays=1024, linear_steps=16, binary_steps=b).error_p95 for b in (0, 2, 6)]
-    assert errors[0] > 2 * errors[1] > 0 and errors[1] > 2 * errors[2], errors
-    step_texels = math.tan(math.radians(60)) * 0.05 * 128 / 16
-    assert errors[2] <= step_texels / 2**6 * 1.01
+    steps = (0, 1, 2, 4)
+    errors = [measure("relief", h, 60, rays=1024, linear_steps=4, binary_steps=b).error_p95 for b in steps]
+    assert all(a > 2.5 * b > 0 for a, b in zip(errors, errors[1:])), errors
+    step_texels = math.tan(math.radians(60)) * 0.05 * 128 / 4
+    assert all(e <= step_texels / 2**b for e, b in zip(errors, steps)), errors
 
 
-def test_relief_without_binary_steps_is_steep(gpu):
+def test_relief_without_binary_steps_is_pom(gpu):
+    """The secant through the bracket of the linear search is POM's interpolation (to float32 rounding)."""
     h = height_map("ridges")
     uv, view = random_rays(512, 50, seed=4)
     a = probe("relief", h, uv, view, 0.05, linear_steps=16, binary_steps=0)
-    b = probe("steep", h, uv, view, 0.05, layers=16)
+    b = probe("pom", h, uv, view, 0.05, layers=16)
     assert np.allclose(a.uv, b.uv, atol=1e-5) and np.array_equal(a.fetches, b.fetches)
 
 
@@ -217,9 +222,10 @@ def test_distance_refined_uses_the_same_tracer():
 
 def test_distance_refined_fetches_against_plain(gpu):
     """Both exact; the refined map takes fewer fetches inside its cone, the more the steeper, and beyond it the plain
-    volume's (stored as float16, rounded down: a hair shorter steps)."""
+    volume's (stored as float16, rounded down: a hair shorter steps). Both start at the map's shallowest depth, which
+    saves the plain map's short steps above the relief more than the refined map's long ones."""
     h = height_map("bricks")
-    for angle, most in ((30, 0.995), (60, 0.95), (80, 0.8), (87, 1.01)):
+    for angle, most in ((30, 0.995), (60, 0.96), (80, 0.86), (87, 1.01)):
         plain = measure("distance", h, angle, rays=1024)
         refined = measure("distance_refined", h, angle, rays=1024)
         assert plain.error_p95 <= 0.01 and refined.error_p95 <= 0.01
@@ -362,7 +368,7 @@ def test_the_renderer_marches_the_materials_range(gpu, tmp_path):
                                          position=(0.3, 0.8, 1.2)))
     renderer = Renderer(parse_scene(scene_path.read_text(), scene_path), gpu)
     image = renderer.render(renderer.config("steep", {"layers": 8}), (48, 32))
-    depth = mode_data(image, "depth")[image.covered]
+    depth = mode_data(image, "layer_depth")[image.covered]
     lo, hi = renderer.depth_range("m")
     assert np.allclose((lo, hi), depth_range(1.0 - height, gpu.depth_format), atol=1e-4)  # (16-bit PNG)
     k = (depth - lo) / ((hi - lo) / 8)

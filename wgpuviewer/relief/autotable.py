@@ -13,11 +13,11 @@ the map); its cost there is the larger SIMD-tile cost of the two edges times ``C
 its fetches in POM fetches). Where no candidate meets the budget, the most accurate one is used and the table says
 so (its error channel exceeds the budget).
 
-POM's layer count scales with tan(angle) inside a bin (``pom_layers``, auto.wgsl's auto_pom_layers): a candidate's
-count n holds at the bin's upper edge, and below it the count that keeps the layers' horizontal spacing, down to
-``lower_edge_layers(n)`` at the lower edge. So the table measures every POM candidate twice per angle: with n (for
-the bin that ends there) and with ``lower_edge_layers(n)`` (for the bin that starts there; rows after the candidates,
-``SCALED``).
+POM's layer count and relief's linear steps scale with tan(angle) inside a bin (``scaled_layers``, auto.wgsl's
+auto_layers): a candidate's count n holds at the bin's upper edge, and below it the count that keeps the layers'
+horizontal spacing, down to ``lower_edge_layers(n)`` at the lower edge. So the table measures every such candidate
+twice per angle: with n (for the bin that ends there) and with ``lower_edge_layers(n)`` (for the bin that starts
+there; rows after the candidates, ``SCALED``).
 
 The measurements are cached on disk next to maptools' maps (content hash of the depth map + height scale +
 candidates, their WGSL code, the rays; ``maptools.cache``'s key and folder, kind ``auto_table``). This module gets
@@ -50,21 +50,24 @@ from .techniques import (
 )
 
 #: Bump when what ``measure`` computes changes (cached tables are then measured again).
-VERSION = 3
-#: The POM candidates (indices into AUTO_CANDIDATES) whose scaled lower-edge count is measured too: table row
+VERSION = 4
+#: The parameter holding the layer count auto scales inside a bin, per candidate technique that has one.
+LAYER_PARAM = {"pom": "layers", "relief": "linear_steps"}
+#: The candidates (indices into AUTO_CANDIDATES) whose scaled lower-edge count is measured too: table row
 #: len(AUTO_CANDIDATES) + k holds candidate SCALED[k] run with ``lower_edge_layers`` of its count.
-SCALED = tuple(c for c, (name, _) in enumerate(AUTO_CANDIDATES) if name == "pom")
+SCALED = tuple(c for c, (name, _) in enumerate(AUTO_CANDIDATES) if name in LAYER_PARAM)
 ERROR_RAYS = 1024  # independent random rays per angle for the error
 TILES = 16  # screen tiles per angle for the cost
 TILE = (8, 4)  # rays per tile: across x along the view azimuth, like a SIMD group of 8 x 4 pixels
 TILE_SPACING = 0.75  # texels between neighbouring rays of a tile
 SEED = 13
 #: Time of one SIMD-tile fetch of each candidate in POM fetches, for choosing between candidates that meet a budget.
-#: Measured on llvmpipe (process CPU time of 96x54 to 192x108 frames, brick and bricks at 45 and 80 degrees): a
-#: quadmax fetch - a dependent 128-bit load, its unpacking, up to three quadratic solves - costs 1.9-3.5 POM fetches,
-#: median 3.2 (docs/techniques.md). The H100 run put the exact walks (maxmip, distance) at 6-12 POM fetches per
-#: fetch; a GPU run of the benchmark reports this per technique ("time per SIMD-tile fetch") to recalibrate.
-COST_WEIGHTS = {"basic": 1.0, "parallax": 1.0, "pom": 1.0, "quadmax": 3.0}
+#: Measured on llvmpipe (docs/techniques.md, auto): process CPU time of 192x108 frames (brick, bricks, ridges, grass at
+#: 45-80 degrees), per technique the slope of the time against the SIMD-tile fetches over settings with different
+#: fetch counts (POM 16/32; relief 8+2, 12+1, 16+2; quadmax capped at 2, 4 and uncapped steps), over POM's slope:
+#: relief 0.78-1.11 (median 1.05), quadmax 2.8-4.8 (median 3.16; a dependent 128-bit load, its unpacking, up to three
+#: quadratic solves). A GPU run of the benchmark reports this per technique ("time per SIMD-tile fetch") to recalibrate.
+COST_WEIGHTS = {"basic": 1.0, "parallax": 1.0, "pom": 1.0, "relief": 1.05, "quadmax": 3.2}
 #: Columns of a measurement: p95 and p97.5 UV error (texels), mean fetches, SIMD-tile cost, capped fraction.
 FIELDS = ("err_p95", "err_p975", "fetches_mean", "fetches_simd", "capped")
 
@@ -89,9 +92,10 @@ def lower_edge_layers(n: int) -> int:
     return max(1, math.ceil(n * 2.0 ** (-1.0 / AUTO_BINS_PER_OCTAVE)))
 
 
-def pom_layers(n: int, angle_deg) -> np.ndarray:
-    """auto.wgsl's POM layer count for table count n at view angles (degrees), in float64: n in bin 0 and the last
-    bin; inside bins 1 .. AUTO_BINS - 2, ceil(n tan / tan_hi), tan_hi the bin's upper edge, clamped to [1, n]."""
+def scaled_layers(n: int, angle_deg) -> np.ndarray:
+    """auto.wgsl's layer count (POM layers, relief linear steps) for table count n at view angles (degrees), in
+    float64: n in bin 0 and the last bin; inside bins 1 .. AUTO_BINS - 2, ceil(n tan / tan_hi), tan_hi the bin's upper
+    edge, clamped to [1, n]."""
     angle = np.asarray(angle_deg, np.float64)
     b = bin_of(angle)
     tan_hi = AUTO_TAN0 * 2.0 ** (b / AUTO_BINS_PER_OCTAVE)
@@ -134,7 +138,7 @@ def _measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndar
     per_angle = n_err + n_cost
     error_rays = (np.arange(len(uv)) % per_angle) < n_err
     ref = exact_hit(depth, uv[error_rays], view[error_rays], height_scale)
-    runs = [*AUTO_CANDIDATES, *(("pom", {"layers": lower_edge_layers(AUTO_CANDIDATES[c][1]["layers"])}) for c in SCALED)]
+    runs = [*AUTO_CANDIDATES, *(lower_edge_run(c) for c in SCALED)]
     out = np.zeros((len(runs), len(angles), len(FIELDS)))
     height = 1.0 - np.asarray(depth, np.float64)
     for c, (name, params) in enumerate(runs):
@@ -152,6 +156,13 @@ def _measure(depth: np.ndarray, height_scale: float, probe: Callable) -> np.ndar
             out[c, a] = (np.percentile(e, 95), np.percentile(e, 97.5), f.mean(), f.reshape(TILES, -1).max(axis=1).mean(),
                          capped[a * per_angle:(a + 1) * per_angle].mean())
     return out
+
+
+def lower_edge_run(candidate: int) -> tuple[str, dict]:
+    """A SCALED candidate as auto runs it at a bin's lower edge: its layer count lowered to ``lower_edge_layers``."""
+    name, params = AUTO_CANDIDATES[candidate]
+    key = LAYER_PARAM[name]
+    return name, {**params, key: lower_edge_layers(params[key])}
 
 
 def candidates_code() -> str:
@@ -186,7 +197,7 @@ def choose(table: np.ndarray) -> np.ndarray:
     lo = np.arange(AUTO_BINS)
     hi = np.minimum(lo + 1, AUTO_BINS - 1)
     err_lo, simd_lo = err[:n, lo].copy(), simd[:n, lo].copy()
-    scaled = (lo >= 1) & (lo < AUTO_BINS - 1)  # bins whose lower edge runs POM's scaled count (pom_layers)
+    scaled = (lo >= 1) & (lo < AUTO_BINS - 1)  # bins whose lower edge runs the scaled count (scaled_layers)
     for k, c in enumerate(SCALED):
         err_lo[c, scaled] = err[n + k, lo[scaled]]
         simd_lo[c, scaled] = simd[n + k, lo[scaled]]
@@ -203,14 +214,15 @@ def choose(table: np.ndarray) -> np.ndarray:
 
 def texels(table: np.ndarray) -> np.ndarray:
     """The table texture's texels, float32 (AUTO_BUDGET_LEVELS, AUTO_BINS, 4): candidate index, method id (auto.wgsl),
-    the method's parameter (POM layers, quadmax top_offset), the chosen candidate's error at the worse edge."""
+    the method's parameter (POM layers, relief linear steps, quadmax top_offset), relief's binary steps (else 0)."""
     choice = choose(table)
     out = np.zeros(choice.shape, np.float32)
     for j in range(AUTO_BUDGET_LEVELS):
         for b in range(AUTO_BINS):
             name, params = AUTO_CANDIDATES[int(choice[j, b, 0])]
-            value = params.get("layers", params.get("top_offset", TECHNIQUES[name].defaults().get("top_offset", 0)))
-            out[j, b] = (choice[j, b, 0], AUTO_METHODS[name], value, choice[j, b, 1])
+            resolved = {**TECHNIQUES[name].defaults(), **params}
+            value = resolved.get(LAYER_PARAM.get(name, "top_offset"), 0)
+            out[j, b] = (choice[j, b, 0], AUTO_METHODS[name], value, resolved.get("binary_steps", 0))
     return out
 
 
@@ -244,8 +256,10 @@ def describe(table: np.ndarray, max_error: float) -> list[str]:
         met = "" if choice[b:end + 1, 3].all() else " (budget not met)"
         label = candidate_label(int(choice[b, 0]))
         name, params = AUTO_CANDIDATES[int(choice[b, 0])]
-        if name == "pom" and b >= 1 and end < AUTO_BINS - 1:  # scaled with tan inside each bin (pom_layers)
-            label = f"pom layers={lower_edge_layers(params['layers'])}-{params['layers']} by angle"
+        if name in LAYER_PARAM and b >= 1 and end < AUTO_BINS - 1:  # scaled with tan inside each bin
+            key = LAYER_PARAM[name]
+            scaled = {**params, key: f"{lower_edge_layers(params[key])}-{params[key]}"}
+            label = " ".join([name, *(f"{k}={v}" for k, v in scaled.items())]) + " by angle"
         lines.append(f"{lo:.1f}-{hi}: {label}, p97.5 <= {worst:.3g} texel, "
                      f"cost <= {float(choice[b:end + 1, 2].max()):.3g}{met}")
         b = end + 1

@@ -199,16 +199,24 @@ REFINED_MAX_ANGLE = 85.0
 
 
 
+#: relief's cap on binary steps (its parameter's range; auto clamps the table's count to it).
+RELIEF_BINARY_STEPS_MAX = 32
+#: auto's relief candidates (linear steps, binary steps): POM's counts up to 32 with one or two halvings (no halving
+#: is POM; a third saves 0.4 % of the table cost on the benchmark's maps, docs/techniques.md).
+AUTO_RELIEF_STEPS = tuple((n, b) for n in (4, 6, 8, 12, 16, 24, 32) for b in (1, 2))
 #: ``auto``'s candidates, cheapest first: (technique, parameter overrides). The shader runs each one's code
-#: (basic: the entry point; parallax; pom_search with the layer count; quadmax_search with the top offset); the
-#: probe measures each one as that technique (relief/autotable.py).
+#: (basic: the entry point; parallax; pom_search with the layer count; relief_search with its linear and binary
+#: steps; quadmax_search with the top offset); the probe measures each one as that technique (relief/autotable.py).
 AUTO_CANDIDATES: tuple[tuple[str, dict], ...] = (
     ("basic", {}), ("parallax", {}),
-    *(("pom", {"layers": n}) for n in (4, 6, 8, 12, 16, 24, 32, 48, 64)),
+    # the layer searches by their fetch bound less one (POM: layers; relief: linear + binary steps)
+    *sorted((*(("pom", {"layers": n}) for n in (4, 6, 8, 12, 16, 24, 32, 48, 64)),
+             *(("relief", {"linear_steps": n, "binary_steps": b}) for n, b in AUTO_RELIEF_STEPS)),
+            key=lambda candidate: sum(candidate[1].values())),
     ("quadmax", {}),
 )
 #: auto's method ids in its table (auto.wgsl switches on them).
-AUTO_METHODS = {"basic": 0, "parallax": 1, "pom": 2, "quadmax": 3}
+AUTO_METHODS = {"basic": 0, "parallax": 1, "pom": 2, "quadmax": 3, "relief": 4}
 #: auto's view-angle bins: bin 0 is tan(angle) < AUTO_TAN0, bin i + 1 is [tan0 2^(i/k), tan0 2^((i+1)/k)) with
 #: k = AUTO_BINS_PER_OCTAVE, up to AUTO_BINS bins (the last one open-ended): the search cost follows the ray's
 #: reach tan(angle) * S * W, so the bins are even in its logarithm (about 88.7 degrees at the last edge).
@@ -296,11 +304,12 @@ TECHNIQUES: dict[str, Technique] = {
         Technique(
             "relief", "7",
             "Relief mapping (Policarpo): linear search in equal depth steps, then binary search between the last "
-            "step above the surface and the first below it.",
+            "step above the surface and the first below it, ended by the secant through the final bracket's ends "
+            "(no extra fetch; with 0 binary steps this is POM).",
             "up to linear_steps+1+binary_steps depth fetches", ("albedo", "normal", "depth"),
             (
                 Param("linear_steps", 16, 1, MAX_LAYERS, int, "linear search steps (depth layers)"),
-                Param("binary_steps", 6, 0, 32, int, "binary refinement steps (each halves the bracket)"),
+                Param("binary_steps", 6, 0, RELIEF_BINARY_STEPS_MAX, int, "binary refinement steps (each halves the bracket)"),
             ),
             ray_search=True, fetch_bound=lambda p: p["linear_steps"] + 1 + p["binary_steps"],
             cost_view_scale=lambda p: p["linear_steps"] + 1.0 + p["binary_steps"],
@@ -382,8 +391,9 @@ TECHNIQUES: dict[str, Technique] = {
         Technique(
             "auto", "-",
             "The error budget as a technique: per pixel, the view angle picks the cheapest candidate (basic, "
-            "parallax, POM 4-64 layers, quadmax) whose p97.5 UV error the probe measured within max_error on this "
-            "material's own height map, at both ends of the angle bin (relief/autotable.py; cached with the maps).",
+            "parallax, POM 4-64 layers, relief 4-32 linear steps with 1 or 2 binary steps, quadmax) whose p97.5 UV "
+            "error the probe measured within max_error on this material's own height map, at both ends of the "
+            "angle bin (relief/autotable.py; cached with the maps).",
             "the chosen candidate's fetches (one table texel, not counted)",
             ("albedo", "normal", "depth", "quadmax", "auto_table"),
             (Param("max_error", 0.5, 2.0 ** AUTO_BUDGET_LOG2_MIN, 2.0 ** (AUTO_BUDGET_LOG2_MIN + AUTO_BUDGET_LEVELS - 1),
@@ -391,7 +401,8 @@ TECHNIQUES: dict[str, Technique] = {
                    "above this is used)"),),
             ray_search=True,
             fixed=(Fixed("bin_tan0", AUTO_TAN0, "f32"), Fixed("bins_per_octave", AUTO_BINS_PER_OCTAVE, "u32"),
-                   Fixed("budget_log2_min", AUTO_BUDGET_LOG2_MIN, "i32"), Fixed("quadmax_steps", QUADMAX_STEPS, "u32")),
+                   Fixed("budget_log2_min", AUTO_BUDGET_LOG2_MIN, "i32"), Fixed("quadmax_steps", QUADMAX_STEPS, "u32"),
+                   Fixed("binary_steps_max", RELIEF_BINARY_STEPS_MAX, "u32")),
             fetch_bound=lambda p: max(TECHNIQUES[name].fetch_bound(resolve_params(TECHNIQUES[name], params))
                                       for name, params in AUTO_CANDIDATES if TECHNIQUES[name].ray_search),
             cost_view_scale=common_cost_scale,

@@ -115,8 +115,9 @@ fn quadmax_walk(uv0: vec2f, v: vec3f, top_offset: i32, max_steps: u32) -> Quadma
     var even_max = vec4f(0.0);
     var odd_node = vec3i(-1);
     var odd_max = vec4f(0.0);
-    var cell = vec2i(floor(start));
-    var t = 0.0;
+    // Above the map's shallowest depth the ray meets nothing: the walk starts there (relief_range, common/trace.wgsl).
+    var t = relief_range(0.0).x;
+    var cell = vec2i(floor(start + t * dir));
     var level = top;
     var step = 0u;  // steps: a descent, a node passed above, a leaf solved; at most max_steps in all
     // Two loops, as Aila & Laine's "while-while" traversal: the inner one walks the nodes until one is a leaf the ray

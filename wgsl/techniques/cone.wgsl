@@ -12,6 +12,7 @@
 // lies inside the true one, so any lower bound of D(p) may serve as the apex. A ray moves k = |V.xy / V.z| * S * W
 // texels of u per unit t. Cell coordinates x = u * W - 0.5 (cells between texel centres, as cell.wgsl).
 //
+// The ray starts at the map's shallowest depth (depth_min): above it the ray meets nothing.
 // A step from t (everything before t_free is proven free; t itself was reached by a cone step or a cell exit):
 // 1. skip (after a cone step): read q's texel (1 fetch). If t < d_q the ray is free here; if the cone step
 //    t_cone = t + (d_q - t) c / (k + c) also leaves the current cell, take it: 1 fetch per skip.
@@ -52,12 +53,12 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     let k = length(span) * f32(wh.x);       // texels of u per unit t (the cone map's metric)
     let widest = trace_params.max_ratio;    // the map's largest stored ratio
     let cap = clamp(trace_params.iterations, ITERATIONS_MIN, ITERATIONS_MAX);
-    var t = 0.0;
-    var t_free = 0.0;   // the ray is free on [0, t_free]
-    var cell = vec2i(floor(start));
-    // The last step went to a cell's exit (or, at the start, no cone could leave the first cell even from the top
-    // of the relief): the cell is solved first.
-    var crawl = widest <= walk_node(cell, 0u, wh, start, dir).t_exit * (k + widest);
+    var t = relief_range(0.0).x;  // depth_min (common/trace.wgsl)
+    var t_free = t;     // the ray is free on [0, t_free]
+    var cell = vec2i(floor(start + t * dir));
+    // The last step went to a cell's exit (or, at the start, no cone could leave the first cell even with its apex
+    // at the floor of the relief): the cell is solved first.
+    var crawl = widest * (1.0 - t) <= (walk_node(cell, 0u, wh, start, dir).t_exit - t) * (k + widest);
     var bracketed = false;
     for (var i = 0u; i < cap; i++) {
         let n = walk_node(cell, 0u, wh, start, dir);

@@ -10,6 +10,7 @@
 // a step of r / that in t. Where that step would not even leave the current bilinear cell (close to the surface
 // radii shrink towards 0 and sphere tracing crawls), the cell is solved exactly (cell_hit, common/cell.wgsl) and
 // left at its exit if it holds no hit: the tracer never passes through a surface and its hit is exact to float32.
+// The search starts at the map's shallowest depth (depth_min): above it the ray meets nothing.
 // Bounded by `iterations` (capped rays are flagged and stop short of the surface, never behind it).
 // #include "common/cell.wgsl"
 // #include "common/wrap.wgsl"
@@ -50,7 +51,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     let dir = -span * size;
     let per_t = size.x * length(vec3f(span, trace_params.height_scale));
     let cap = clamp(trace_params.iterations, ITERATIONS_MIN, ITERATIONS_MAX);
-    var t = 0.0;
+    var t = relief_range(0.0).x;  // depth_min (common/trace.wgsl)
     for (var step = 0u; step < cap; step++) {
         let texel = vec2i(floor((uv0 - span * t) * size));
         let k = clamp(i32(floor(t * f32(slices))), 0, slices - 1);

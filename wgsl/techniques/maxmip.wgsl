@@ -7,12 +7,13 @@
 // [i * 2^m, (i + 1) * 2^m) of its row/column from above. The levels sit in one r32float atlas
 // (level m at rows [row_m, row_m + h_m)), read with textureLoad: no sampler, no mip rules.
 //
-// Traversal: start at the top; at a node, compute where the ray leaves the node's cells; if it is
-// still above the node's highest point there (t_exit < 1 - max), skip the node and look from one
-// level up; otherwise descend. At level 0 the cell's exact quadratic is solved (cell_hit, common/cell.wgsl),
-// so the first hit matches wgpuviewer/reference.py to float32 precision, thin walls and spikes
-// included. The current cell is tracked as integers (stepped explicitly on exits), so rounding can
-// never make the walk stall or go back. Bounded by max_steps (capped rays are flagged).
+// Traversal: start at the top, at the map's shallowest depth; at a node, compute where the ray leaves the node's
+// cells; if it is still above the node's highest point there (t_exit < 1 - max), skip the node and look at the next
+// one on the same level while it has the same parent (that parent was entered because the ray may reach its relief:
+// testing it again would only descend again), else from one level up; otherwise descend. At level 0 the cell's
+// exact quadratic is solved (cell_hit, common/cell.wgsl), so the first hit matches wgpuviewer/reference.py to float32
+// precision, thin walls and spikes included. The current cell is tracked as integers (stepped explicitly on exits),
+// so rounding can never make the walk stall or go back. Bounded by max_steps (capped rays are flagged).
 // Addressing: the pyramid wraps (repeat), as the renderer's sampler does.
 // #include "common/cell.wgsl"
 
@@ -37,8 +38,9 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     let size = vec2f(wh);
     let start = uv0 * size - 0.5;
     let dir = -span * size;  // texel coordinates per unit t
-    var cell = vec2i(floor(start));
-    var t = 0.0;
+    // Above the map's shallowest depth the ray meets nothing: the walk starts there (relief_range, common/trace.wgsl).
+    var t = relief_range(0.0).x;
+    var cell = vec2i(floor(start + t * dir));
     var level = top;
     let cap = clamp(trace_params.max_steps, MAX_STEPS_MIN, MAX_STEPS_MAX);
     for (var step = 0u; step < cap; step++) {
@@ -56,10 +58,11 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
                 return TraceResult(uv0 - span * t_hit, t_hit, fetch_count, is_grazing(v), 0u);
             }
         }
-        // Nothing in this node: step into the next one along the ray and look from one level up.
+        // Nothing in this node: step into the next one along the ray, on this level within the same parent.
         t = max(t, n.t_exit);
         cell = next_cell(start, dir, t, n.exits, n.lo, n.hi);
-        level = min(level + 1u, top);
+        let same_parent = all((wrap_texel(cell, wh) >> vec2u(level + 1u)) == (n.index >> vec2u(1u)));
+        level = select(min(level + 1u, top), level, same_parent && level < top);
     }
     return TraceResult(uv0 - span * t, t, fetch_count, true, 0u);
 }

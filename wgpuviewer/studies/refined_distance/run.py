@@ -22,7 +22,7 @@ from wgpuviewer.harness.header import Clock, Header
 from wgpuviewer.harness.plots import MISSING, pyplot, save_png
 from wgpuviewer.harness.table import Column, Table
 from wgpuviewer.relief.accuracy import simd_tile_cost
-from wgpuviewer.relief.maps import DISTANCE_SLICES
+from wgpuviewer.relief.maps import DISTANCE_SLICES, depth_range
 from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 
 from .baseline import plain_before
@@ -140,13 +140,14 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
         for name in maps:
             heightmap = load_heightmap(name, suite.builtin_size, Path(workdir))
             depth = 1.0 - heightmap.height.astype(np.float64)
+            depth_min = depth_range(depth, gpu.depth_format)[0]  # where the GPU tracer starts
             views = [make_view(heightmap, a, suite.resolution) for a in (angles or suite.angles)]
             for variant in VARIANTS:
                 volumes, seconds = _build(variant, heightmap.height, HEIGHT_SCALE)
                 for view in views:
                     covered = np.ones(view.uv0.shape[:2], bool)
                     got = trace(depth, volumes, view.uv0.reshape(-1, 2), view.v_ts.reshape(-1, 3), HEIGHT_SCALE,
-                                **variant.bins())
+                                depth_min=depth_min, **variant.bins())
                     rows.append(_row(heightmap, view, variant, "numpy twin", got.fetches.reshape(covered.shape),
                                      covered, got.capped, seconds, volumes))
                     if variant.technique:

@@ -2,7 +2,8 @@
 no registered technique binds (a single cone, sectors without bands, K = 1 sub-cells) on the very rays the renderer
 traces. It takes the same steps and counts the same fetches (tests/studies checks it against the GPU probe): per
 iteration one volume fetch; a sphere step when it leaves the current bilinear cell, else the exact solve of that cell
-(one gather) and on to the cell's exit.
+(one gather) and on to the cell's exit. Like the tracer it starts at the map's shallowest depth (``depth_min``, as
+``relief.maps.depth_range`` gives it for the uploaded texture): above it the ray meets nothing.
 """
 
 from __future__ import annotations
@@ -23,9 +24,10 @@ class Traced:
 
 
 def trace(depth: np.ndarray, volumes: np.ndarray, uv0, view_dir, height_scale: float, *, sectors: int = 1,
-          bands: int = 1, max_angle: float | None = None, iterations: int = 256) -> Traced:
+          bands: int = 1, max_angle: float | None = None, iterations: int = 256, depth_min: float = 0.0) -> Traced:
     """Trace rays (uv0 (N, 2), tangent-space V (N, 3), V.z > 0) through ``volumes``: (Dz, H, W) for the plain map, or
-    the refined kind's (V, Dz, H, W) with its ``sectors``, ``bands`` and ``max_angle``. ``depth`` = 1 - height."""
+    the refined kind's (V, Dz, H, W) with its ``sectors``, ``bands`` and ``max_angle``. ``depth`` = 1 - height;
+    ``depth_min``: where the search starts (the tracer's ``relief_range(0).x``)."""
     vol = np.asarray(volumes, np.float64)
     vol = vol[None] if vol.ndim == 3 else vol
     _, slices, vh, vw = vol.shape
@@ -40,7 +42,7 @@ def trace(depth: np.ndarray, volumes: np.ndarray, uv0, view_dir, height_scale: f
     start = uv0 * size - 0.5
     step = -span * size
     per_t = cols * np.sqrt((span ** 2).sum(axis=1) + height_scale ** 2)
-    t = np.zeros(n)
+    t = np.full(n, min(max(depth_min, 0.0), 1.0))
     t_hit = np.full(n, np.nan)
     fetches = np.zeros(n, np.int64)
     run = np.arange(n)
