@@ -4,6 +4,7 @@ offset mean what they say, and bad or extreme coefficient sets are handled (norm
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -143,3 +144,26 @@ def test_spans_refuse_coordinates_float32_cannot_hold():
         g.Spans(np.array([2**24]), np.array([0]), 10)
     with pytest.raises(InputError, match="equal"):
         g.Spans(np.array([0, 1]), np.array([0]), 10)
+
+
+@pytest.mark.parametrize("setup", [g.Setup(span_length=64, rows=4, tilt=80.0), g.Setup(span_length=3840, rows=16,
+                                                                                         tilt=89.9, offset=1e4)])
+def test_at_footprint_gives_the_middle_pixel_the_asked_footprint_and_scales_coordinates_with_it(setup):
+    for target in (0.5, 1.0, 3.0):
+        scaled = g.at_footprint(setup, target)
+        assert g.middle_footprint(scaled) == pytest.approx(target, rel=1e-6)
+        assert replace(scaled, texels_per_unit=setup.texels_per_unit) == setup  # nothing else changes
+    with pytest.raises(InputError, match="texels_per_pixel"):
+        g.at_footprint(setup, 0.0)
+
+
+def test_tiles_cover_the_frame_once_left_to_right_row_by_row():
+    spans = g.tiles_of((256, 3), 16)
+    assert spans.length == 16 and spans.count == 48
+    x, y = spans.pixels()
+    covered = set(zip(x.ravel().astype(int), y.ravel().astype(int)))
+    assert len(covered) == x.size == 256 * 3
+    assert list(spans.x0[:3]) == [0, 16, 32] and list(spans.y[15:17]) == [0, 1]
+    for width in (0, 17, 512):
+        with pytest.raises(InputError, match="tile width"):
+            g.tiles_of((256, 3), width)

@@ -31,12 +31,15 @@ def _cases():
     for length in (1, 2, 63):
         short = g.build(g.Setup(span_length=length, rows=2, tilt=60.0))
         yield f"{length}-pixel spans", short, short.spans
+    # spans shorter than parallel_32's threads, more of them than one workgroup holds at 32 threads a span
+    tile = g.build(g.Setup(span_length=16, rows=9, tilt=80.0))
+    yield "9 spans of 16 pixels", tile, tile.spans
 
 
 CASES = list(_cases())
 
 
-@pytest.mark.parametrize("name", list(M.METHODS))
+@pytest.mark.parametrize("name", [name for name, m in M.METHODS.items() if m.on_gpu])
 def test_every_kernel_is_its_numpy_twin(gpu, name):
     kernels = kernels_for(gpu)
     allowed = 0 if gpu.software else HARDWARE_ULP
@@ -48,6 +51,14 @@ def test_every_kernel_is_its_numpy_twin(gpu, name):
         assert ulp_difference(got.u, want.u) <= allowed, label
         assert ulp_difference(got.v, want.v) <= allowed, label
         assert np.isfinite(got.u).all() and np.isfinite(got.v).all()
+
+
+def test_a_method_without_a_kernel_is_refused_by_name(gpu):
+    quad = g.build(g.Setup(span_length=4, rows=1, tilt=45.0))
+    missing = [name for name, m in M.METHODS.items() if not m.on_gpu]
+    assert missing  # the adaptive subdivision is a CPU loop only
+    with pytest.raises(ValueError, match=f"{missing[0]} has no GPU kernel"):
+        kernels_for(gpu).prepare(missing[0], quad.coefficients, quad.spans)
 
 
 def test_too_many_spans_for_one_dispatch_is_a_clear_error(gpu):

@@ -1,6 +1,7 @@
 """The numpy forms of the methods: float64 agreement, float32 drift against span length (measured and against the
-rounding bound each form implies), the mitigations' bounds, the hard cases (edge-on, past the horizon, short and
-odd spans) and the operation counts."""
+rounding bound each form implies), the mitigations' bounds, the one-reciprocal forms, the adaptive subdivision and
+its error bound, the hard cases (edge-on, past the horizon, short and odd spans) and the operation counts (as
+written, and with fused multiply-adds)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ from wgpuviewer.studies.perspective.arith import Arith
 from wgpuviewer.studies.perspective.run import instances  # imports wgpu before the log fixture touches its logger
 
 PAPER = [name for name, m in M.METHODS.items() if m.family == "paper"]
+RECIPROCAL = [name for name, m in M.METHODS.items() if m.family == "reciprocal"]
+ADAPTIVE = [f"adaptive_{e}" for e in M.ADAPTIVE_FRACTIONS]
 DRIFT = g.Setup(span_length=8192, rows=2, tilt=80.0)
 
 
@@ -38,7 +41,7 @@ def drift_quad():
 def test_float64_forms_agree_with_direct_to_1e_9_texel(setup):
     quad = g.build(setup)
     ref = g.reference(quad.coefficients, quad.spans)
-    for name in PAPER:
+    for name in PAPER + RECIPROCAL:
         assert np.nanmax(error(name, "float64", quad, ref)) <= 1e-9, name
 
 
@@ -58,6 +61,109 @@ def test_subdivided_is_exact_at_its_anchors_and_an_approximation_between():
         at = M.anchors(100, every)
         assert np.nanmax(err[:, at]) <= 1e-9
         assert np.nanmax(err) > 1e-3  # perspective is not affine: the error between anchors is real
+
+
+# --- one reciprocal ----------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name, twin", [("direct_rcp", "direct"), ("span_rcp", "span")])
+def test_one_reciprocal_is_within_two_ulps_of_the_two_divisions(name, twin):
+    """u = w_u (1 / q) rounds twice where w_u / q rounds once: at most 1.5 ulp apart in exact arithmetic, so within
+    2 ulp of the divided value, with the same flags; and it is a different computation (some pixels differ)."""
+    quad = g.build(g.Setup(span_length=1920, rows=4, tilt=85.0, offset=1e3))
+    rcp, _ = M.evaluate(name, "float32", quad.coefficients, quad.spans)
+    div, _ = M.evaluate(twin, "float32", quad.coefficients, quad.spans)
+    assert np.array_equal(rcp.flagged, div.flagged)
+    for a, b in ((rcp.u, div.u), (rcp.v, div.v)):
+        assert (np.abs(a.astype(np.float64) - b) <= 2 * _ulp(b)).all()
+    assert (rcp.u != div.u).any()
+
+
+# --- adaptive subdivision ----------------------------------------------------------------------------------------
+
+def test_the_chord_error_in_pixels_is_the_closed_form_and_within_the_bound():
+    """docs/perspective.md: for u = (w0 + a t) / (q0 + d t), the chord between t = 0 and t = S errs by
+    G d t (S - t) / (q0 qS q(t)) (G = a q0 - d w0), which over the x footprint |G| / q(t)^2 is
+    |d| t (S - t) q(t) / (q0 qS) pixels, at most |d| S^2 / (4 min(q0, qS))."""
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        w0, a = rng.uniform(-1e3, 1e3), rng.uniform(-2, 2)
+        q0, d = rng.uniform(0.1, 2.0), rng.uniform(-1e-2, 1e-2)
+        span = rng.integers(2, 60)
+        if q0 + d * span <= 0:
+            continue
+        t = np.linspace(0.0, span, 2001)
+        q, qs = q0 + d * t, q0 + d * span
+        u = (w0 + a * t) / q
+        chord = w0 / q0 + t / span * ((w0 + a * span) / qs - w0 / q0)
+        footprint = np.abs(a * q0 - d * w0) / q**2
+        pixels = np.abs(u - chord) / footprint
+        closed = np.abs(d) * t * (span - t) * q / (q0 * qs)
+        np.testing.assert_allclose(pixels, closed, rtol=1e-6, atol=1e-9)
+        bound = abs(d) * span**2 / (4 * min(q0, qs))
+        assert pixels.max() <= bound * (1 + 1e-9)
+        if abs(d) * span / min(q0, qs) < 1e-3:  # tight when q barely changes over the segment
+            assert pixels.max() >= 0.99 * bound
+
+
+def _within_bound(d: float, q: np.ndarray, fraction: int, steps: np.ndarray) -> np.ndarray:
+    """|d| S^2 <= 4 min(q, q + d S) / E: the chord over S pixels errs at most 1/E pixel."""
+    return abs(d) * steps**2 <= 4 * (q + min(d, 0.0) * steps) / fraction * (1 + 1e-12)
+
+
+def test_segment_length_is_the_longest_the_bound_allows():
+    ar = Arith(np.float64)
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        d = rng.choice([-1.0, 1.0]) * 10 ** rng.uniform(-6, -2)
+        fraction = int(rng.choice(M.ADAPTIVE_FRACTIONS))
+        k = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [d, 0.0, 1.0]])
+        rule = M.segment_rule(ar, k, fraction)
+        q = 10 ** rng.uniform(-1, 0, 8)
+        remaining = np.full(8, 10**6)
+        steps = M.segment_length(ar, rule, q, remaining)
+        assert (_within_bound(d, q, fraction, steps) | (steps == 1)).all()  # one pixel: no interpolation at all
+        assert not _within_bound(d, q, fraction, steps + 1).any()
+    assert (M.segment_length(ar, rule, np.array([-1.0, 0.0]), np.array([9, 9])) == 1).all()  # no anchor to trust
+    affine = M.segment_rule(ar, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), 8)
+    assert (M.segment_length(ar, affine, np.array([1.0]), np.array([77])) == 77).all()  # D = 0: u is affine
+
+
+@pytest.mark.parametrize("tilt", [30.0, 80.0, 89.0, 89.9, 95.0])
+def test_adaptive_holds_its_error_below_its_fraction_of_a_pixel(tilt):
+    """The bound is the interpolation's; float32 rounding adds at most what `direct` itself errs, twice over."""
+    quad = g.build(g.Setup(span_length=1920, rows=3, tilt=tilt))
+    ref = g.reference(quad.coefficients, quad.spans)
+    rounding = 2 * np.nanmax(error("direct", "float32", quad, ref) / ref.footprint)
+    for name in ADAPTIVE:
+        pixels = error(name, "float32", quad, ref) / ref.footprint
+        assert np.nanmax(pixels) <= 1 / M.METHODS[name].param + rounding, name
+        assert np.nanmax(pixels) >= 0.5 / M.METHODS[name].param, name  # and uses the room it has
+
+
+def test_adaptive_spends_anchors_where_q_changes_fast():
+    exact = {}
+    for tilt in (30.0, 80.0, 89.9):
+        quad = g.build(g.Setup(span_length=1920, rows=3, tilt=tilt))
+        for name in ADAPTIVE:
+            exact[name, tilt] = M.evaluate(name, "float32", quad.coefficients, quad.spans)[0].exact
+    for name in ADAPTIVE:
+        assert exact[name, 30.0] < exact[name, 80.0] < exact[name, 89.9], name
+    assert all(exact[ADAPTIVE[0], t] < exact[ADAPTIVE[-1], t] for t in (30.0, 80.0, 89.9))  # a finer bound costs more
+    flat = np.array([[1.0, 0.1, 3.0], [0.2, 1.0, 5.0], [0.0, 0.0, 1.0]])  # D = E = 0: an affine map
+    spans = g.Spans(np.zeros(4, np.int64), np.arange(4, dtype=np.int64), 500)
+    result, _ = M.evaluate(ADAPTIVE[0], "float64", flat, spans)
+    assert result.exact == 2 * 4  # both ends of every span
+    np.testing.assert_allclose(result.u, g.reference(flat, spans).u, rtol=0, atol=1e-9)
+
+
+def test_adaptive_is_exact_at_its_anchors():
+    """Float64: the anchors are the span form; between them the error is the chord's."""
+    quad = g.build(g.Setup(span_length=1000, rows=2, tilt=89.0))
+    ref = g.reference(quad.coefficients, quad.spans)
+    for name in ADAPTIVE:
+        err = error(name, "float64", quad, ref)
+        assert np.nanmax(err[:, [0, -1]]) <= 1e-9
+        assert np.nanmax(err / ref.footprint) <= 1 / M.METHODS[name].param * (1 + 1e-6)
 
 
 # --- float32 drift -----------------------------------------------------------------------------------------------
@@ -224,7 +330,7 @@ def test_short_odd_and_offset_spans(length):
         result, _ = M.evaluate(name, method.precisions[0], quad.coefficients, spans)
         assert result.u.shape == (5, length)
         assert not result.flagged.any()
-        tolerance = 1.0 if method.family == "reference" else 0.05  # subdivided: affine between anchors
+        tolerance = 1.0 if method.family == "approximation" else 0.05  # linear between anchors
         assert np.hypot(result.u - ref.u, result.v - ref.v).max() < tolerance, name
 
 
@@ -255,6 +361,7 @@ def test_evaluate_refuses_a_precision_the_method_does_not_have():
 #: (add, mul, div, guard, int add) per texel for u and v together, as the code does them (docs/perspective.md).
 CODE_OPS = {
     "direct": (6, 6, 2, 3, 0), "span": (3, 3, 2, 0, 0), "incremental": (3, 0, 2, 0, 0), "two_ended": (3, 0, 2, 0, 0),
+    "direct_rcp": (6, 8, 1, 3, 0), "span_rcp": (3, 5, 1, 0, 0),
     **{f"parallel_{k}": (3, 0, 2, 0, 0) for k in M.PARALLEL_THREADS},
     "kahan": (12, 0, 2, 3, 0), "double_single": (36, 0, 2, 9, 0), "fixed16_16": (0, 2, 2, 0, 3),
 }
@@ -265,6 +372,35 @@ def test_operation_counts_per_texel_come_from_the_code(name):
     ops = M.ops_per_texel(name)
     got = tuple(ops.get(kind, (0.0, 0.0))[0] for kind in ("add", "mul", "div", "guard", "int_add"))
     assert got == pytest.approx(CODE_OPS[name], abs=1e-9)
+
+
+#: (add, mul, fma, div) per texel with each product fused into the one addition that uses it.
+FUSED_OPS = {
+    "direct": (3, 3, 3, 2), "span": (0, 0, 3, 2), "incremental": (3, 0, 0, 2), "direct_rcp": (3, 5, 3, 1),
+    "span_rcp": (0, 2, 3, 1), "kahan": (12, 0, 0, 2), "subdivided_8": (2 / 8, 0, 3 / 8 + 2, 4 / 8),
+}
+
+
+@pytest.mark.parametrize("name", list(FUSED_OPS))
+def test_fma_aware_counts_fuse_each_product_into_its_one_addition(name):
+    """On FMA hardware formula (3) is three fused multiply-adds per texel against the incremental form's three
+    additions: the same instruction count."""
+    ops = M.ops_per_texel(name, fused=True)
+    got = tuple(ops.get(kind, (0.0, 0.0))[0] for kind in ("add", "mul", "fma", "div"))
+    assert got == pytest.approx(FUSED_OPS[name], abs=1e-9)
+
+
+def test_a_product_used_twice_is_not_fused():
+    ar = Arith(np.float32)
+    a = np.ones(4, np.float32)
+    product = ar.mul(a, a)
+    ar.add(product, a)
+    assert dict(ar.fused) == {"mul": 0, "fma": 4}
+    ar.add(product, a)  # used again: a multiplication and two additions after all
+    assert (ar.fused["mul"], ar.fused["fma"], ar.fused["add"]) == (4, 0, 8)
+    both = Arith(np.float32)
+    both.add(both.mul(a, a), both.mul(a, a))  # a x + b y: one product fuses, the other stays a multiplication
+    assert (both.fused["mul"], both.fused["fma"], both.fused["add"]) == (4, 4, 0)
 
 
 def test_the_paper_counts_the_shared_denominator_once_per_coordinate():

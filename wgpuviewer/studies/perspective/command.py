@@ -17,7 +17,10 @@ class Perspective:
                                 "full: every sweep, 4K frames (minutes on a software adapter); smoke: seconds, for CI")
 
     def options(self, args) -> dict:
-        """``run.run``'s keyword arguments (argparse has checked the suite)."""
+        """``run.run``'s keyword arguments (argparse has checked the suite); numba is there for the compiled loops."""
+        from .compiled import numba_module
+
+        numba_module()
         return {"suite_name": args.suite, "backend": args.backend, "progress": not args.quiet,
                 "command": args.command_line}
 

@@ -25,7 +25,7 @@ away from float32 overflow and underflow.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -107,6 +107,17 @@ def rows_of(frame: tuple[int, int]) -> Spans:
     """The spans of a whole frame (W, H): one per row, from x = 0."""
     w, h = frame
     return Spans(np.zeros(h, np.int64), np.arange(h, dtype=np.int64), w)
+
+
+def tiles_of(frame: tuple[int, int], width: int) -> Spans:
+    """The spans of a whole frame (W, H) cut into pieces of ``width`` pixels (W a multiple of it), each its own span
+    from its own start, as a tile or GPU rasteriser walks a row: row by row, left to right."""
+    w, h = frame
+    if not (isinstance(width, int) and 1 <= width <= w and w % width == 0):
+        raise InputError(f"tile width {width!r}: expected a divisor of the frame width {w}")
+    per_row = w // width
+    return Spans(np.tile(np.arange(0, w, width, dtype=np.int64), h), np.repeat(np.arange(h, dtype=np.int64), per_row),
+                 width)
 
 
 @dataclass(frozen=True)
@@ -328,6 +339,24 @@ def reference(coefficients: np.ndarray, spans: Spans) -> Reference:
     steps = [np.hypot((k[0, c] - k[2, c] * u) / safe_q, (k[1, c] - k[2, c] * v) / safe_q) for c in (0, 1)]
     footprint = np.where(ok, np.maximum(*steps), np.inf)
     return Reference(u, v, ok, footprint)
+
+
+def middle_footprint(setup: Setup) -> float:
+    """The texel footprint (``Reference.footprint``) of the frame's middle pixel (column L // 2 of the middle row)."""
+    quad = build(setup)
+    middle = Spans(np.array([setup.span_length // 2]), np.array([setup.rows // 2]), 1)
+    return float(reference(quad.coefficients, middle).footprint[0, 0])
+
+
+def at_footprint(setup: Setup, texels_per_pixel: float) -> Setup:
+    """``setup`` with the texel density that gives its middle pixel a footprint of ``texels_per_pixel`` texels.
+    Texel coordinates are the wall's position times the density (plus the offset), so the footprint scales with it
+    exactly: spans of any length then sample the texture alike, and their coordinates grow with the length, as a
+    longer span over the same texture reaches further."""
+    if not (math.isfinite(texels_per_pixel) and texels_per_pixel > 0):
+        raise InputError(f"texels_per_pixel = {texels_per_pixel!r}: expected a positive number")
+    scale = texels_per_pixel / middle_footprint(setup)
+    return replace(setup, texels_per_unit=setup.texels_per_unit * scale)
 
 
 # --- the same quad for the renderer ---------------------------------------------------------------------------

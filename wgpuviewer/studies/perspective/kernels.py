@@ -25,9 +25,11 @@ from .methods import METHODS, Method, Result, fixed_setup, split
 SOURCE = "studies/perspective/kernels.wgsl"
 #: Kernels that are forms of a shared entry point (one thread per pixel, or one per span walking it), with the
 #: value of its pipeline-overridable FORM (generated into the module as FORM_* constants).
-FORMS = {"direct": ("per_pixel", 0), "span": ("per_pixel", 1), "incremental": ("sequential", 2),
-         "reanchor": ("sequential", 3), "kahan": ("sequential", 4), "double_single": ("sequential", 5),
-         "fixed16_16": ("sequential", 6)}
+FORMS = {"direct": ("per_pixel", 0), "span": ("per_pixel", 1), "direct_rcp": ("per_pixel", 2),
+         "span_rcp": ("per_pixel", 3), "incremental": ("sequential", 4), "reanchor": ("sequential", 5),
+         "kahan": ("sequential", 6), "double_single": ("sequential", 7), "fixed16_16": ("sequential", 8)}
+#: Kernels that read the per-span constants ``span_setup`` writes.
+AFTER_SPAN_SETUP = ("span", "span_rcp")
 WORKGROUP = 64  # @workgroup_size of every kernel
 #: What a user can do when a kernel does not build on their adapter, or the spans do not fit its limits.
 FIX = "run on another adapter (--backend)"
@@ -115,10 +117,12 @@ class Kernels:
     def prepare(self, name: str, coefficients: np.ndarray, spans: Spans, outputs: Outputs | None = None) -> Dispatch:
         """Inputs, bind group and dispatches of method ``name`` on ``spans`` (into ``outputs``, or new ones)."""
         method = METHODS[name]
+        if not method.on_gpu:
+            raise ValueError(f"method {name} has no GPU kernel")
         what = f"{spans.count} spans of {spans.length} pixels"
         threads = method.threads_per_span(spans.length)
         if threads == 0:  # one thread per pixel: x along the span, y over the spans
-            steps = [("span_setup", (spans.count,))] if method.kernel == "span" else []
+            steps = [("span_setup", (spans.count,))] if method.kernel in AFTER_SPAN_SETUP else []
             steps.append((method.kernel, (spans.length, spans.count)))
         else:
             steps = [(method.kernel, (spans.count * threads,))]

@@ -13,6 +13,12 @@ The methods differ only in how they get w_u, w_v and q at each n (the paper's na
 - ``two_ended``: one thread walks up from n = 0, another down from n = L - 1 (started there by the span form);
 - ``subdivided_S``: exact (span form) every S pixels and at the span's end, linear in between (Quake's affine
   subdivision);
+- ``adaptive_E``: the same, with each segment as long as the interpolation error bound allows: at most 1/E of a
+  pixel (``segment_length``; the bound is derived in docs/perspective.md);
+
+the one-reciprocal forms, which divide once and multiply twice (``r = 1 / q``, ``u = w_u r``, ``v = w_v r``):
+
+- ``direct_rcp``: formula (1) so; ``span_rcp``: formula (3) so;
 
 and the mitigations of the incremental form's drift:
 
@@ -54,6 +60,8 @@ class Result:
     u: np.ndarray  # (R, L) texels, 0 where flagged
     v: np.ndarray
     flagged: np.ndarray  # (R, L) bool
+    exact: int | None = None  # exact (u, v) evaluations (each a division or reciprocal of q): the pixels, or the
+    # anchors; None where not counted (the compiled loops, the rasteriser)
 
 
 def _divide(ar: Arith, w: np.ndarray, clip: np.ndarray) -> Result:
@@ -63,7 +71,17 @@ def _divide(ar: Arith, w: np.ndarray, clip: np.ndarray) -> Result:
     ok = valid(wu, wv, q) & clip
     u, v = ar.div(wu, q), ar.div(wv, q)
     zero = ar.cast(0)
-    return Result(np.where(ok, u, zero), np.where(ok, v, zero), ~ok)
+    return Result(np.where(ok, u, zero), np.where(ok, v, zero), ~ok, q.size)
+
+
+def _reciprocal(ar: Arith, w: np.ndarray, clip: np.ndarray) -> Result:
+    """``_divide`` with one division: r = 1 / q, u = w_u r, v = w_v r (each rounded: up to an ulp from w_u / q)."""
+    wu, wv, q = w
+    ok = valid(wu, wv, q) & clip
+    r = ar.div(ar.cast(1), q)
+    u, v = ar.mul(wu, r), ar.mul(wv, r)
+    zero = ar.cast(0)
+    return Result(np.where(ok, u, zero), np.where(ok, v, zero), ~ok, q.size)
 
 
 def _full(a: np.ndarray, spans: Spans) -> np.ndarray:
@@ -97,17 +115,29 @@ def _steps(first: np.ndarray, step: np.ndarray, count: int) -> np.ndarray:
     return out
 
 
-def direct(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
-    k = ar.cast(k64)
+def _direct_form(ar: Arith, k: np.ndarray, spans: Spans) -> np.ndarray:
+    """Formula (1)'s numerators and denominator, (3, R, L)."""
     x, y = (ar.cast(c) for c in spans.pixels())
-    w = ar.add(ar.guard(ar.add(ar.mul(_full(k[:, 0], spans), x), ar.mul(_full(k[:, 1], spans), y))),
-               _full(k[:, 2], spans))
-    return _divide(ar, w, inside(k64, spans))
+    return ar.add(ar.guard(ar.add(ar.mul(_full(k[:, 0], spans), x), ar.mul(_full(k[:, 1], spans), y))),
+                  _full(k[:, 2], spans))
+
+
+def direct(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
+    return _divide(ar, _direct_form(ar, ar.cast(k64), spans), inside(k64, spans))
+
+
+def direct_rcp(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
+    return _reciprocal(ar, _direct_form(ar, ar.cast(k64), spans), inside(k64, spans))
 
 
 def span(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
     k = ar.cast(k64)
     return _divide(ar, _span_form(ar, k, span_start(ar, k, spans), _n(ar, spans)), inside(k64, spans))
+
+
+def span_rcp(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
+    k = ar.cast(k64)
+    return _reciprocal(ar, _span_form(ar, k, span_start(ar, k, spans), _n(ar, spans)), inside(k64, spans))
 
 
 def incremental(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
@@ -148,6 +178,25 @@ def anchors(length: int, every: int) -> np.ndarray:
     return np.unique(np.r_[np.arange(0, length, every), length - 1])
 
 
+def _interpolate(ar: Arith, at: np.ndarray, exact: Result, length: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """u, v and flags (R, length) linear between exact values at the increasing positions ``at`` (first 0, last
+    length - 1; ``exact`` holds (R, len(at)) values there, 0 where flagged): value + m * slope in each segment,
+    slope = (next - value) / width; a segment with a flagged end is flagged; the last pixel is its anchor's."""
+    n = np.arange(length)
+    seg = np.minimum(np.searchsorted(at, n, side="right") - 1, at.size - 2)
+    width = ar.cast(np.diff(at))
+    out = []
+    for c in (exact.u, exact.v):
+        slope = ar.div(ar.sub(c[:, 1:], c[:, :-1]), width)
+        line = ar.add(c[:, seg], ar.mul(ar.cast(np.broadcast_to(n - at[seg], c[:, seg].shape)), slope[:, seg]))
+        line[:, -1] = c[:, -1]  # the last pixel is an anchor
+        out.append(line)
+    flagged = exact.flagged[:, seg] | exact.flagged[:, seg + 1]
+    flagged[:, -1] = exact.flagged[:, -1]
+    zero = ar.cast(0)
+    return np.where(flagged, zero, out[0]), np.where(flagged, zero, out[1]), flagged
+
+
 def subdivided(every: int) -> Callable:
     def evaluate(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
         k = ar.cast(k64)
@@ -155,19 +204,83 @@ def subdivided(every: int) -> Callable:
         exact = _divide(ar, _span_form(ar, k, span_start(ar, k, spans), _n(ar, spans, at)), inside(k64, spans)[:, at])
         if at.size == 1:
             return exact
-        n = np.arange(spans.length)
-        seg = np.minimum(np.searchsorted(at, n, side="right") - 1, at.size - 2)
-        width = ar.cast(np.diff(at))
+        return Result(*_interpolate(ar, at, exact, spans.length), exact.exact)
+
+    return evaluate
+
+
+@dataclass(frozen=True)
+class SegmentRule:
+    """``segment_length``'s per-polygon constants, in the method's precision: with d = D (q's step per pixel),
+    m = max(-d, 0), the largest S with |d| S^2 <= 4 (q + min(d, 0) S) / E is 2 (sqrt(m^2 + |d| E q) - m) / (E |d|)."""
+
+    d: np.ndarray  # D
+    m: np.ndarray  # max(-D, 0)
+    m2: np.ndarray  # m^2
+    dE: np.ndarray  # |D| E (exact: E is a power of two)
+    scale: np.ndarray  # 2 / (E |D|)
+
+
+def segment_rule(ar: Arith, k: np.ndarray, fraction: int) -> SegmentRule:
+    d = k[2, 0]
+    ad, m = np.abs(d), np.maximum(-d, ar.cast(0))
+    e = ar.cast(fraction)
+    return SegmentRule(d, m, ar.mul(m, m), ar.mul(ad, e), ar.div(ar.cast(2), ar.mul(e, ad)))
+
+
+def segment_length(ar: Arith, rule: SegmentRule, q: np.ndarray, remaining: np.ndarray) -> np.ndarray:
+    """Pixels to the next anchor from an anchor whose denominator is ``q`` (``remaining`` pixels to the span's
+    end, at least 1): the largest S whose linear interpolation stays within 1/E of a pixel (docs/perspective.md:
+    the error of the chord of u = w / q over S pixels is at most |D| S^2 / (4 min q) pixels of the x footprint),
+    at least 1, at most ``remaining``; all of ``remaining`` where D = 0 (u is then affine), 1 where q <= 0."""
+    if rule.d == 0:
+        return remaining.copy()
+    s = ar.mul(ar.sub(ar.sqrt(ar.add(rule.m2, ar.mul(rule.dE, q))), rule.m), rule.scale)
+    ok = (q > 0) & (s >= 1)  # NaN fails
+    return np.where(ok, np.floor(np.minimum(np.where(ok, s, 1), ar.cast(remaining))), 1).astype(np.int64)
+
+
+def adaptive(fraction: int) -> Callable:
+    def evaluate(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
+        k = ar.cast(k64)
+        clip = inside(k64, spans)
+        start = span_start(ar, k, spans)
+        rule = segment_rule(ar, k, fraction)
+        last = spans.length - 1
+        found = []  # per step: (spans, positions, exact values there)
+        p = np.zeros(spans.count, np.int64)
+        active = np.arange(spans.count)
+        while active.size:  # one anchor of every span still walking; each step moves at least one pixel
+            w = ar.add(start[:, active], ar.mul(k[:, 0:1], ar.cast(p[active])[None]))
+            found.append((active, p[active], _divide(ar, w[:, :, None], clip[active, p[active]][:, None])))
+            walking = p[active] < last
+            active = active[walking]
+            if active.size:
+                p[active] += segment_length(ar, rule, w[2, walking], last - p[active])
+        span = np.concatenate([f[0] for f in found])
+        at = np.concatenate([f[1] for f in found])
+        order = np.lexsort((at, span))  # every span's anchors in order, span after span
+        span, at = span[order], at[order]
+        cu, cv, cf = (np.concatenate([getattr(f[2], c)[:, 0] for f in found])[order] for c in ("u", "v", "flagged"))
+        if spans.length == 1:
+            return Result(cu[:, None], cv[:, None], cf[:, None], at.size)
+        # pixel n of span r lies in the segment of the last anchor at or before it; the last pixel, an anchor
+        # itself, in the segment before it (methods._interpolate)
+        rows = np.arange(spans.count)[:, None]
+        pixel = rows * spans.length + np.arange(spans.length)
+        seg = np.searchsorted(span * spans.length + at, pixel, side="right") - 1
+        seg[:, -1] -= 1
+        width = ar.cast(np.diff(at))  # across spans too: those pairs are never used
         out = []
-        for c in (exact.u, exact.v):
-            slope = ar.div(ar.sub(c[:, 1:], c[:, :-1]), width)
-            line = ar.add(c[:, seg], ar.mul(_n(ar, spans, n - at[seg]), slope[:, seg]))
-            line[:, -1] = c[:, -1]  # the last pixel is an anchor
+        for c in (cu, cv):
+            slope = ar.div(ar.sub(c[1:], c[:-1]), width)
+            line = ar.add(c[seg], ar.mul(ar.cast(np.arange(spans.length) - at[seg]), slope[seg]))
+            line[:, -1] = c[seg[:, -1] + 1]
             out.append(line)
-        flagged = exact.flagged[:, seg] | exact.flagged[:, seg + 1]
-        flagged[:, -1] = exact.flagged[:, -1]
+        flagged = cf[seg] | cf[seg + 1]
+        flagged[:, -1] = cf[seg[:, -1] + 1]
         zero = ar.cast(0)
-        return Result(np.where(flagged, zero, out[0]), np.where(flagged, zero, out[1]), flagged)
+        return Result(np.where(flagged, zero, out[0]), np.where(flagged, zero, out[1]), flagged, at.size)
 
     return evaluate
 
@@ -260,7 +373,7 @@ def fixed16_16(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
     u, v = ar.mul(ar.div(wu, q), fx.ratio[0]), ar.mul(ar.div(wv, q), fx.ratio[1])
     ok = (q > 0) & (np.abs(u) <= UMAX) & (np.abs(v) <= UMAX) & inside(k64, spans)
     zero = ar.cast(0)
-    return Result(np.where(ok, u, zero), np.where(ok, v, zero), ~ok)
+    return Result(np.where(ok, u, zero), np.where(ok, v, zero), ~ok, q.size)
 
 
 # --- the registry ---------------------------------------------------------------------------------------------
@@ -269,19 +382,22 @@ def fixed16_16(ar: Arith, k64: np.ndarray, spans: Spans) -> Result:
 @dataclass(frozen=True)
 class Method:
     name: str
-    family: str  # "paper" (the seed's formulas), "reference" (a practical point of comparison), "mitigation"
+    family: str  # FAMILIES
     summary: str
     evaluate: Callable[[Arith, np.ndarray, Spans], Result]
-    kernel: str  # its WGSL kernel (an entry point, or a form of a shared one: kernels.FORMS)
-    param: int = 0  # k, S or M
+    kernel: str  # its loop: the WGSL kernel (an entry point, or a form of a shared one: kernels.FORMS), compiled.LOOPS
+    param: int = 0  # k, S, M or E
     precisions: tuple[str, ...] = ("float32", "float64")
     #: (adds, muls, divs) per texel for u and v together as the paper states them ("implied": by its formula)
     paper_ops: tuple[int, int, int] | None = None
     paper_note: str = ""
+    on_gpu: bool = True  # has a WGSL kernel
+    #: its operations per texel depend on the geometry (adaptive segments): counted on each configuration instead
+    ops_vary: bool = False
 
     def threads_per_span(self, length: int) -> int:
         """GPU threads per span (0: one thread per pixel)."""
-        if self.kernel in ("direct", "span"):
+        if self.kernel in PER_PIXEL:
             return 0
         if self.kernel == "parallel":
             return min(self.param, length)
@@ -292,22 +408,31 @@ class Method:
         return 1
 
 
+#: The families of methods: the paper's formulas, its formulas with one reciprocal, the approximations (linear
+#: between exact anchors: their error is the interpolation's, not rounding), the mitigations of the drift.
+FAMILIES = ("paper", "reciprocal", "approximation", "mitigation")
+PER_PIXEL = ("direct", "span", "direct_rcp", "span_rcp")  # kernels with one thread per pixel
 PARALLEL_THREADS = (2, 4, 8, 16, 32)
 SUBDIVISIONS = (8, 16)
+ADAPTIVE_FRACTIONS = (8, 32)  # adaptive_E holds the interpolation error to 1/E of a pixel (powers of two)
 REANCHOR_EVERY = (16, 64, 256)
 
 _METHODS: list[Method] = [
     Method("direct", "paper", "formula (1) per pixel", direct, "direct", paper_ops=(8, 8, 2), paper_note="stated"),
     Method("span", "paper", "formula (3): per-span constants, ut + A n per pixel", span, "span",
            paper_ops=(4, 4, 2), paper_note="stated"),
+    Method("direct_rcp", "reciprocal", "formula (1) with r = 1 / q, u = w_u r, v = w_v r", direct_rcp, "direct_rcp"),
+    Method("span_rcp", "reciprocal", "formula (3) with r = 1 / q, u = w_u r, v = w_v r", span_rcp, "span_rcp"),
     Method("incremental", "paper", "formula (4): w += A, q += D, one thread per span", incremental, "incremental",
            paper_ops=(4, 0, 2), paper_note="implied by (4)"),
     *(Method(f"parallel_{k}", "paper", f"formula (5): {k} interleaved threads per span, steps of {k} A",
              parallel(k), "parallel", k, paper_ops=(4, 0, 2), paper_note="implied by (5)") for k in PARALLEL_THREADS),
     Method("two_ended", "paper", "two threads per span, from both ends towards the middle", two_ended, "two_ended",
            paper_ops=(4, 0, 2), paper_note="implied by (4)"),
-    *(Method(f"subdivided_{s}", "reference", f"exact every {s} pixels, linear in between (Quake)", subdivided(s),
-             "subdivided", s) for s in SUBDIVISIONS),
+    *(Method(f"subdivided_{s}", "approximation", f"exact every {s} pixels, linear in between (Quake)",
+             subdivided(s), "subdivided", s) for s in SUBDIVISIONS),
+    *(Method(f"adaptive_{e}", "approximation", f"exact at anchors spaced so that linear interpolation errs at most "
+             f"1/{e} pixel", adaptive(e), "adaptive", e, on_gpu=False, ops_vary=True) for e in ADAPTIVE_FRACTIONS),
     *(Method(f"reanchor_{m}", "mitigation", f"incremental, span form afresh every {m} pixels", reanchor(m),
              "reanchor", m, precisions=("float32",)) for m in REANCHOR_EVERY),
     Method("kahan", "mitigation", "incremental with Kahan-compensated sums", kahan, "kahan", precisions=("float32",)),
@@ -332,17 +457,19 @@ def evaluate(name: str, precision: str, coefficients: np.ndarray, spans: Spans) 
 
 
 @functools.cache
-def ops_per_texel(name: str, precision: str | None = None, lengths=(256, 512)) -> dict[str, tuple[float, float]]:
+def ops_per_texel(name: str, precision: str | None = None, lengths=(256, 512),
+                  fused: bool = False) -> dict[str, tuple[float, float]]:
     """Operations per texel and per span of ``name``, by kind, from running it on one span of two lengths
-    (multiples of every k, S and M): {kind: (per texel, per span)}. Per-polygon work (the k A of the parallel
-    forms) counts as per span."""
+    (multiples of every k, S and M): {kind: (per texel, per span)}; ``fused``: as FMA hardware executes them
+    (``Arith.fused``). Per-polygon work (the k A of the parallel forms) counts as per span. Methods whose counts
+    depend on the geometry (``Method.ops_vary``) get this one geometry's."""
     method = METHODS[name]
     precision = precision or method.precisions[0]
     k = np.array([[1.0, 0.1, 3.0], [0.2, 1.0, 5.0], [-1e-4, 1e-5, 1.0]])
     tallies = []
     for length in lengths:
         _, ar = evaluate(name, precision, k, Spans(np.zeros(1, np.int64), np.zeros(1, np.int64), length))
-        tallies.append(ar.tally)
+        tallies.append(ar.fused if fused else ar.tally)
     kinds = sorted(set(tallies[0]) | set(tallies[1]))
     out = {}
     for kind in kinds:

@@ -1,5 +1,6 @@
 """The perspective study's plots (``report.PLOTS`` lists them): error against span length, tilt and coordinate
-magnitude, along one long span, against cost, the drift's heat map and the relief tie-back."""
+magnitude, along one long span, the approximations against tilt, error against cost, the drift's heat map and the
+relief tie-back. Errors are in screen pixels (texels in a second row where the texture's scale matters)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,18 @@ import numpy as np
 from wgpuviewer.harness.plots import pyplot, save_png
 
 from .methods import METHODS
-from .report import MITIGATIONS, PAPER_F32, REFERENCE_F32, first_row, select_rows, single_precision
+from .report import (
+    APPROXIMATIONS,
+    MITIGATIONS,
+    PAPER_F32,
+    RECIPROCAL,
+    first_row,
+    select_rows,
+    single_precision,
+    speed_frames,
+)
+
+HORIZON = 90.0  # degrees: from here on a span reaches the wall's horizon (its undefined pixels are flagged)
 
 
 def write_plots(out: Path, rows: list[dict], along: list[dict], relief: list[dict], heat: dict) -> bool:
@@ -19,14 +31,14 @@ def write_plots(out: Path, rows: list[dict], along: list[dict], relief: list[dic
         if plt is None:
             return False
         plot_sweep(plt, rows, "span_length", "span_length", out / "error_vs_span_length.png", "span length (pixels)",
-                   True, "Float32 error against span length")
+                   True, "Float32 error against span length, a texel per pixel at the frame's middle")
         plot_along(plt, along, out / "error_along_span.png")
         plot_sweep(plt, rows, "tilt", "tilt_deg", out / "error_vs_tilt.png", "angle at the span's far end (degrees)",
-                   False, "Float32 error against tilt: in texels, and in pixels of the footprint there",
-                   values=("max_err", "max_err_px"))
+                   False, "Float32 error against tilt (hollow, shaded: at or past the horizon; flagged pixels left out)")
         plot_sweep(plt, rows, "magnitude", "coord_max_texels", out / "error_vs_magnitude.png",
                    "largest texture coordinate in the frame (texels)", True,
                    "Float32 error against coordinate magnitude")
+        plot_approximations(plt, rows, out / "approximations.png")
         plot_pareto(plt, rows, out / "pareto.png")
         plot_heatmap(plt, heat, out / "drift_heatmap.png")
         plot_tieback(plt, relief, out / "tieback.png")
@@ -37,38 +49,58 @@ def _style(name: str) -> dict:
     if name == "hardware":
         return {"color": "black", "linestyle": "-", "linewidth": 2.2, "marker": "s", "markersize": 4}
     family = METHODS[name].family
-    return {"linestyle": {"paper": "-", "reference": ":", "mitigation": "--"}[family], "marker": "o", "markersize": 3}
+    return {"linestyle": {"paper": "-", "reciprocal": "-.", "approximation": ":", "mitigation": "--"}[family],
+            "marker": "o", "markersize": 3}
 
 
-VALUE_LABELS = {"max_err": "max texture-coordinate error (texels)",
-                "max_err_px": "max error / the pixel's texel footprint (pixels)"}
+VALUE_LABELS = {"max_err_px": "worst pixel's error (screen pixels)",
+                "max_err": "worst pixel's error (texels)"}
+
+
+def _points(rows, sweep: str, key: str, method: str, value: str) -> list[tuple[float, float, float]]:
+    """(x, error, tilt) of ``method``'s rows in ``sweep``, errors > 0 only (a log axis)."""
+    return sorted((r[key], r[value], r["tilt_deg"]) for r in select_rows(rows, sweep=sweep, method=method,
+                                                                         precision=single_precision(method))
+                  if isinstance(r[value], float) and r[value] > 0)
 
 
 def plot_sweep(plt, rows, sweep: str, key: str, path: Path, xlabel: str, logx: bool, title: str,
-               values=("max_err",)) -> None:
-    groups = [("the paper's forms (float32)", PAPER_F32 + ["hardware"]),
-              ("subdivided and mitigations (float32)", ["incremental", *REFERENCE_F32, *MITIGATIONS])]
+               values=("max_err_px", "max_err")) -> None:
+    """Two groups of methods side by side; a row per value (pixels, then texels). Points at or past the horizon
+    are drawn hollow and unconnected over a shaded band: their undefined pixels are flagged and left out, so the
+    error there is over fewer pixels and not comparable with the rest of the line."""
+    groups = [("the paper's forms and one-reciprocal variants (float32)", PAPER_F32 + RECIPROCAL + ["hardware"]),
+              ("approximations and mitigations (float32)", ["incremental", *APPROXIMATIONS, *MITIGATIONS])]
     fig, axes = plt.subplots(len(values), 2, figsize=(13, 4.8 * len(values)), sharey="row", squeeze=False)
     for line, value in zip(axes, values):
         for ax, (label, methods) in zip(line, groups):
+            ax.set_prop_cycle(color=plt.cm.tab20.colors)  # a colour per method: up to 16 lines a panel
             for m in methods:
-                pts = sorted((r[key], r[value]) for r in select_rows(rows, sweep=sweep, method=m, precision=single_precision(m))
-                             if isinstance(r[value], float) and r[value] > 0)
-                if pts:
-                    ax.plot(*zip(*pts), label=m, **_style(m))
+                pts = _points(rows, sweep, key, m, value)
+                before = [(x, e) for x, e, t in pts if t < HORIZON]
+                past = [(x, e) for x, e, t in pts if t >= HORIZON]
+                if before:
+                    (drawn,) = ax.plot(*zip(*before), label=m, **_style(m))
+                    color = drawn.get_color()
+                else:
+                    color = _style(m).get("color")
+                if past:
+                    ax.scatter(*zip(*past), facecolors="none", edgecolors=color, marker=_style(m)["marker"], s=28)
+            if key == "tilt_deg":
+                ax.axvspan(HORIZON, max(r[key] for r in select_rows(rows, sweep=sweep)) + 1, color="0.85", zorder=0)
             ax.set_yscale("log")
             if logx:
                 ax.set_xscale("log")
-                if key == "span_length":  # label lengths people know (1080p and 4K rows), not powers of ten
+                if key == "span_length":  # label lengths people know (tiles, 1080p and 4K rows), not powers of ten
                     from matplotlib.ticker import NullFormatter
 
                     lengths = {r[key] for r in select_rows(rows, sweep=sweep)}
-                    marks = sorted(lengths & {64, 256, 1024, 1920, 3840, 8192, 16384}) or sorted(lengths)
+                    marks = sorted(lengths & {8, 64, 256, 1024, 1920, 3840, 8192, 16384}) or sorted(lengths)
                     ax.set_xticks(marks, [str(int(n)) for n in marks], fontsize=8)
                     ax.xaxis.set_minor_formatter(NullFormatter())
             ax.set_xlabel(xlabel)
-            ax.set_title(label)
-            ax.grid(True, which="both", )
+            ax.set_title(label, fontsize=10)
+            ax.grid(True, which="both")
             ax.legend(fontsize=7, ncol=2)
         line[0].set_ylabel(VALUE_LABELS[value])
     fig.suptitle(title)
@@ -78,40 +110,64 @@ def plot_sweep(plt, rows, sweep: str, key: str, path: Path, xlabel: str, logx: b
 def plot_along(plt, along: list[dict], path: Path) -> None:
     fig, ax = plt.subplots(figsize=(8, 4.8))
     for m in ["incremental", "parallel_2", "parallel_8", "parallel_32", "two_ended", "direct", "kahan", "hardware"]:
-        pts = [((r["n_start"] + r["n_end"]) / 2, r["max_err"]) for r in along
-               if r["method"] == m and r["precision"] == single_precision(m) and r["max_err"] > 0]
+        pts = [((r["n_start"] + r["n_end"]) / 2, r["max_err_px"]) for r in along
+               if r["method"] == m and r["precision"] == single_precision(m) and r["max_err_px"] > 0]
         if pts:
             ax.plot(*zip(*pts), label=m, **_style(m))
     ax.set_yscale("log")
     ax.set_xlabel("position along the span n (pixels)")
-    ax.set_ylabel("max error in the bin (texels)")
+    ax.set_ylabel("worst pixel's error in the bin (screen pixels)")
     length = along[0]["span_length"] if along else 0
     ax.set_title(f"Where the float32 error builds up along a {int(length)}-pixel span")
-    ax.grid(True, which="both", )
+    ax.grid(True, which="both")
     ax.legend(fontsize=8)
     save_png(fig, path)
 
 
+def plot_approximations(plt, rows, path: Path) -> None:
+    """Fixed and adaptive subdivision against tilt: worst pixel's error, and what it costs in exact evaluations."""
+    fig, axes = plt.subplots(1, 2, figsize=(13, 4.8))
+    for m in APPROXIMATIONS:
+        style = _style(m) | {"linestyle": "-" if m.startswith("adaptive") else ":"}
+        for ax, value in zip(axes, ("max_err_px", "exact_per_pixel")):
+            pts = _points(rows, "tilt", "tilt_deg", m, value)
+            before = [(x, e) for x, e, t in pts if t < HORIZON]
+            if before:
+                ax.plot(*zip(*before), label=m, **style)
+    for ax, label in zip(axes, ("worst pixel's error (screen pixels)", "exact evaluations per pixel")):
+        ax.set_yscale("log")
+        ax.set_xlabel("angle at the span's far end (degrees, before the horizon)")
+        ax.set_ylabel(label)
+        ax.grid(True, which="both")
+        ax.legend(fontsize=8)
+    length = next((r["span_length"] for r in select_rows(rows, sweep="tilt")), 0)
+    fig.suptitle(f"Linear between exact anchors, L = {int(length)}: every S pixels, or as far as the error bound allows")
+    save_png(fig, path)
+
+
 def plot_pareto(plt, rows, path: Path) -> None:
-    speed = select_rows(rows, sweep="speed")
-    if not speed:
+    frames = speed_frames(rows)
+    if not frames:
         return
-    w, h = speed[0]["span_length"], speed[0]["spans"]
-    here = [r for r in speed if (r["span_length"], r["spans"]) == (w, h)]
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5), sharey=True)
-    for ax, key, label in ((axes[0], "gpu_ratio", "GPU time × direct"), (axes[1], "cpu_ratio", "CPU (numpy) time × direct")):
+    w, h = frames[0]
+    here = select_rows(rows, sweep="speed", span_length=w, spans=h)
+    fig, axes = plt.subplots(1, 3, figsize=(17, 5), sharey=True)
+    for ax, key, label in ((axes[0], "scalar_ratio", "compiled scalar loop, time × direct"),
+                           (axes[1], "simd_ratio", "compiled SIMD build, time × direct"),
+                           (axes[2], "gpu_ratio", "GPU adapter (software adapters: on the CPU), time × direct")):
         for r in here:
-            if not isinstance(r[key], float) or not r["max_err"] > 0:
+            if not isinstance(r[key], float) or not r["max_err_px"] > 0:
                 continue
             style = _style(r["method"])
-            ax.scatter(r[key], r["max_err"], color=style.get("color"), marker=style["marker"], s=30)
-            ax.annotate(r["method"], (r[key], r["max_err"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
+            ax.scatter(r[key], r["max_err_px"], color=style.get("color"), marker=style["marker"], s=30)
+            ax.annotate(r["method"], (r[key], r["max_err_px"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel(label)
-        ax.grid(True, which="both", )
-    axes[0].set_ylabel("max error (texels)")
-    fig.suptitle(f"Error against cost: {int(h)} spans of {int(w)} pixels, tilt {here[0]['tilt_deg']:g}°")
+        ax.grid(True, which="both")
+    axes[0].set_ylabel("worst pixel's error (screen pixels)")
+    direct = first_row(here, method="direct")
+    fig.suptitle(f"Error against cost: {int(h)} spans of {int(w)} pixels, tilt {direct['tilt_deg']:g}°")
     save_png(fig, path)
 
 
@@ -123,14 +179,15 @@ def plot_heatmap(plt, heat: dict, path: Path) -> None:
     picture = np.where(ref.valid, 0.35 + 0.5 * checker, 0.05)
     errors = [heat["incremental"], heat["direct"]]
     top = max(float(np.nanmax(e)) for e in errors)
-    norm = LogNorm(vmin=max(top * 1e-5, 1e-6), vmax=top)
+    norm = LogNorm(vmin=max(top * 1e-5, 1e-9), vmax=top)
     fig, axes = plt.subplots(3, 1, figsize=(9, 11), layout="constrained")
     axes[0].imshow(picture, cmap="gray", vmin=0, vmax=1, interpolation="nearest")
     axes[0].set_title("the quad: a 32-texel checker at the float64 uv, unfiltered (black: past the horizon)")
     for ax, err, name in zip(axes[1:], errors, ("incremental", "direct")):
         image = ax.imshow(err, cmap="inferno", norm=norm, interpolation="nearest")
-        ax.set_title(f"{name}, float32: texel error (max {np.nanmax(err):.3g}); each row is a span, left to right")
-    fig.colorbar(image, ax=list(axes), label="texels (black: below the scale or not compared)", shrink=0.6)
+        ax.set_title(f"{name}, float32: error in screen pixels (max {np.nanmax(err):.3g}); each row is a span, "
+                     f"left to right")
+    fig.colorbar(image, ax=list(axes), label="screen pixels (black: below the scale or not compared)", shrink=0.6)
     for ax in axes:
         ax.set_xticks([])
         ax.set_yticks([])
@@ -145,10 +202,8 @@ def plot_tieback(plt, relief: list[dict], path: Path) -> None:
     fig, ax = plt.subplots(figsize=(8, 5))
     mags = sorted({r["magnitude_uv"] for r in relief if r["magnitude_uv"] > 0})
     for t in dict.fromkeys(r["technique"] for r in relief):
-        for variant, style in (("raw", "-"), ("shader_fract", "--")):
-            pts = [(r["magnitude_uv"], r["p99_err"]) for r in relief
-                   if r["technique"] == t and r["variant"] == variant and r["magnitude_uv"] > 0]
-            ax.plot(*zip(*sorted(pts)), style, marker="o", markersize=3, label=f"{t} ({variant})")
+        pts = [(r["magnitude_uv"], r["p99_err"]) for r in relief if r["technique"] == t and r["magnitude_uv"] > 0]
+        ax.plot(*zip(*sorted(pts)), "-", marker="o", markersize=3, label=t)
     spacing = [first_row(relief, magnitude_uv=m)["input_spacing_texels"] for m in mags]
     ax.plot(mags, spacing, ":", color="black", label="float32 spacing of the uv")
     ax.set_xscale("log")
@@ -156,6 +211,6 @@ def plot_tieback(plt, relief: list[dict], path: Path) -> None:
     ax.set_xlabel("texture coordinate magnitude (UV units; the texture spans 1)")
     ax.set_ylabel("p99 hit-uv error (texels)")
     ax.set_title(f"Relief techniques at large uv ({int(relief[0]['texels'])}² map, {relief[0]['angle_deg']:g}°)")
-    ax.grid(True, which="both", )
+    ax.grid(True, which="both")
     ax.legend(fontsize=7)
     save_png(fig, path)

@@ -1,17 +1,15 @@
-"""The tie-back to relief mapping: how large texture coordinates (heavy ``uv_scale`` tiling) degrade the relief
-techniques' hit uv.
+"""The tie-back to relief mapping: how large texture coordinates (heavy ``uv_scale`` tiling, large offsets) degrade
+the relief techniques' hit uv.
 
 A tiled surface hands each fragment's ray search an interpolated float32 uv of magnitude M (UV units; the texture
-spans 1), so the entry point is already quantised to float32's spacing at M, and the search's own arithmetic
-(``uv0 - t (V.xy / V.z) S``, bilinear weights from ``fract(uv * size)``) runs at M too. We trace the same random rays
-with ``wgpuviewer.relief.probe.probe`` at entry points ``uv0 + M`` (a whole number of tiles: the same texture position
-under repeat addressing) and compare with the float64 exact hit at ``uv0`` (``relief.reference.exact_hit``):
+spans 1), so the entry point is already quantised to float32's spacing at M. The search itself runs on the entry
+point's fraction: the probe (``relief.probe.probe``, repeat addressing) removes the whole tiles in float64 before
+tracing and adds them back to the hit, as the renderer wraps uv per draw. We trace the same random rays at entry
+points ``uv0 + M`` (a whole number of tiles: the same texture position under repeat addressing), rounded to
+float32 as a fragment receives them, and compare with the float64 exact hit at ``uv0``
+(``relief.reference.exact_hit``): what remains is the entry point's quantisation at M, carried through the search.
 
-- ``raw``: the float32 entry point ``uv0 + M``, what a fragment of a heavily tiled surface gets;
-- ``shader_fract``: that float32 value wrapped to [0, 1) in float32 before the search, what ``fract(uv)`` in the
-  shader could do: the search runs at small coordinates, but the bits the entry point lost at M stay lost.
-
-Wrapping per object (a float64 ``-floor(uv)`` offset per object or mesh tile, applied before the uv becomes float32)
+Keeping the coordinates small before they become float32 (a float64 ``-floor(uv)`` offset per object or mesh tile)
 gives exactly the M = 0 row: the entry point never reaches magnitude M.
 """
 
@@ -27,7 +25,7 @@ from wgpuviewer.textures import builtin_height
 HEIGHT_MAP = "bumps"
 ANGLE = 60.0  # degrees from the normal
 HEIGHT_SCALE = 0.05
-VARIANTS = ("raw", "shader_fract")
+VARIANTS = ("float32_entry",)  # the entry point as a fragment receives it
 
 
 def spacing_texels(magnitude: float, texels: int) -> float:
@@ -43,8 +41,7 @@ def measure(techniques, magnitudes, rays: int, texels: int, backend: str | None 
     rows = []
     for technique in techniques:
         for magnitude in magnitudes:
-            raw = (uv0 + magnitude).astype(np.float32)
-            inputs = {"raw": raw, "shader_fract": raw - np.floor(raw)}  # float32 arithmetic, as a shader's fract
+            inputs = {"float32_entry": (uv0 + magnitude).astype(np.float32)}
             for variant in VARIANTS:
                 got = probe(technique, height, inputs[variant], view, HEIGHT_SCALE, backend=backend)
                 ok = ~got.capped & ref.valid

@@ -49,3 +49,9 @@ fn store_uv(s: u32, n: u32, uv: vec2f, flagged: bool) {
 fn store(s: u32, n: u32, w: vec3f) {
     store_uv(s, n, vec2f(w.x / w.z, w.y / w.z), !is_defined(w) || clipped(s, n));
 }
+
+// The same with one division: r = 1 / q, then two multiplications.
+fn store_rcp(s: u32, n: u32, w: vec3f) {
+    let r = 1.0 / w.z;
+    store_uv(s, n, vec2f(w.x * r, w.y * r), !is_defined(w) || clipped(s, n));
+}

@@ -1,5 +1,6 @@
 // Every method of the perspective study as a compute kernel, each the twin of its numpy form in
-// wgpuviewer/studies/perspective/methods.py (same operations in the same order; a test pins them bit for bit).
+// wgpuviewer/studies/perspective/methods.py (same operations in the same order; a test pins them bit for bit),
+// except the adaptive subdivision (a CPU loop only: wgpuviewer/studies/perspective/compiled.py).
 // Per-pixel methods run one thread per pixel (x: pixel in the span, y: span); the others one thread per span
 // (incremental and its mitigations), k threads per span (parallel), two (two_ended) or one per subdivision
 // (subdivided), numbered along x. Every loop is capped.
@@ -10,7 +11,8 @@
 // compiles on its own, without a branch per pixel.
 override FORM: u32 = FORM_DIRECT;
 
-// One thread per pixel: formula (1) (direct), or formula (3) from the constants span_setup wrote (span).
+// One thread per pixel: formula (1) (direct), or formula (3) from the constants span_setup wrote (span); each
+// with two divisions or with one reciprocal (_rcp).
 @compute @workgroup_size(64)
 fn per_pixel(@builtin(global_invocation_id) gid: vec3u) {
     let n = gid.x;
@@ -20,6 +22,8 @@ fn per_pixel(@builtin(global_invocation_id) gid: vec3u) {
     }
     switch FORM {
         case FORM_SPAN: { store(s, n, starts[s].xyz + P.a * f32(n)); }
+        case FORM_SPAN_RCP: { store_rcp(s, n, starts[s].xyz + P.a * f32(n)); }
+        case FORM_DIRECT_RCP: { store_rcp(s, n, linear(f32(spans[s].x0 + i32(n)), f32(spans[s].y))); }
         default: { store(s, n, linear(f32(spans[s].x0 + i32(n)), f32(spans[s].y))); }
     }
 }
@@ -58,10 +62,11 @@ fn incremental(s: u32) {
     }
 }
 
-// k = P.param threads per span: formula (5). Thread j gets w_j by j steps of (4), then steps k * a.
+// k = P.param threads per span: formula (5). Thread j gets w_j by j steps of (4), then steps k * a. A span shorter
+// than k gets one thread per pixel (as many as kernels.py dispatches: Method.threads_per_span), none striding.
 @compute @workgroup_size(64)
 fn parallel(@builtin(global_invocation_id) gid: vec3u) {
-    let k = clamp(P.param, 1u, MAX_THREADS);
+    let k = clamp(min(P.param, span_len()), 1u, MAX_THREADS);
     let t = gid.x;
     let s = t / k;
     let j = t % k;
