@@ -15,28 +15,39 @@ are parsed by ``wgpuviewer.core.env``.
 ``maptools cache info`` shows it, ``maptools cache clean [--older-than 7d]`` empties it; both refuse a cache path
 that is not a folder. A cache folder that cannot be written is a warning for the renderer (maps are then rebuilt
 each run), never an error.
+
+Named maps: inside ``serving({kind: (path, where)})`` (the renderer, around the build of a material whose scene names
+precomputed maps), ``cached_generate`` of that kind serves the file instead, once its batch record
+(``wgpuviewer.core.sidecar``) says it is the map asked for: the same kind, options and maptools version, and the
+file's bytes as the batch wrote them; otherwise a UserError says, against ``where``, what differs and the batch
+command that builds the right map. That the map was built from the material's height file is the scene's check.
+``recording()`` lists what the cache served (built, from the cache, from a named file): ``wgpuviewer warm`` reports
+it, tests count with it.
 """
 
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import hashlib
 import json
 import logging
 import os
 import stat
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from wgpuviewer.core import env
-from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.errors import FileError, UserError
 from wgpuviewer.core.io import WriteError, atomic_open, remove_abandoned_temps
+from wgpuviewer.core.sidecar import read_record
 
 from . import VERSION, generate, validate_height
+from .io import read_map
 from .registry import KINDS, get_kind
 
 CACHE_ENV = env.CACHE_DIR.name
@@ -207,6 +218,91 @@ def write_entry(f, key: str, result) -> None:
     np.savez(f, **members, **{_KEY: np.array(key), _CHECKSUM: np.array(_checksum(key, members))})
 
 
+@dataclass(frozen=True)
+class Served:
+    """One map the cache handed out: its kind, and where it came from: "built" (and stored), "cache" (an entry)
+    or "file" (a named map)."""
+
+    kind: str
+    source: str
+
+
+_recorders: contextvars.ContextVar[tuple[list[Served], ...]] = contextvars.ContextVar("map_recorders", default=())
+_named: contextvars.ContextVar[dict[str, tuple[Path, str]] | None] = contextvars.ContextVar("named_maps", default=None)
+
+
+def _served(kind: str, source: str) -> None:
+    for served in _recorders.get():
+        served.append(Served(kind, source))
+
+
+@contextlib.contextmanager
+def recording() -> Iterator[list[Served]]:
+    """The maps served inside the block, in order (this thread's; nested blocks each see theirs)."""
+    served: list[Served] = []
+    token = _recorders.set((*_recorders.get(), served))
+    try:
+        yield served
+    finally:
+        _recorders.reset(token)
+
+
+@contextlib.contextmanager
+def serving(maps: dict[str, tuple[Path, str]]) -> Iterator[None]:
+    """Inside the block, ``cached_generate`` of a kind in ``maps`` serves that file (module docstring); ``where``
+    names it in errors (the scene key)."""
+    token = _named.set(dict(maps))
+    try:
+        yield
+    finally:
+        _named.reset(token)
+
+
+def _option_text(options: dict, names) -> str:
+    return ", ".join(f"{name}={options[name]}" for name in names)
+
+
+def named_map(kind: str, path: Path, where: str, shape: tuple[int, int], options: dict) -> np.ndarray:
+    """The map of ``kind`` in the file at ``path`` when its record matches the request (``options``: resolved; a
+    map of ``shape`` (H, W)); a UserError against ``where`` otherwise."""
+    try:
+        record = read_record(path)
+    except FileError as error:
+        raise UserError(f"{where}: {error}") from None
+    rebuild = f"maptools batch {record.input} -o {path.parent} --kinds {kind}"
+    if record.kind != kind:
+        raise UserError(f"{where}: is a {record.kind} map (its record says so); expected a {kind} map")
+    if record.version != VERSION:
+        raise UserError(f"{where}: built by {record.version}, this is {VERSION}: rebuild it ({rebuild} --force)")
+    try:
+        found = get_kind(kind).resolve(record.options)
+    except UserError as error:
+        raise UserError(f"{where}: its record's options do not fit this maptools ({error}): rebuild it "
+                        f"({rebuild} --force)") from None
+    differ = [name for name in options if found[name] != options[name]]
+    if differ:
+        defaults = get_kind(kind).resolve({})  # the batch's: every other option the renderer needs is set too
+        sets = " ".join(f"--set {kind}.{name}={value}" for name, value in options.items() if value != defaults[name])
+        raise UserError(f"{where}: built with {_option_text(found, differ)}; the renderer needs "
+                        f"{_option_text(options, differ)}: rebuild it ({rebuild} {sets})")
+    try:
+        data = path.read_bytes()
+    except OSError as error:
+        raise UserError(f"{where}: cannot read {path} ({error.strerror or error})") from None
+    if hashlib.sha256(data).hexdigest() != record.output_sha256:
+        raise UserError(f"{where}: {path.name} changed after maptools batch wrote it (its sha256 is not its "
+                        f"record's): rebuild it ({rebuild} --force)")
+    try:
+        result = read_map(kind, data, path.suffix.lower())
+    except UserError as error:
+        raise UserError(f"{where}: {error}") from None
+    if result.shape[-2:] != tuple(shape):
+        raise UserError(f"{where}: a map of {result.shape[-1]}x{result.shape[-2]} texels; the height map is "
+                        f"{shape[1]}x{shape[0]}")
+    _served(kind, "file")
+    return result
+
+
 def cached(kind: str, key: str, build: Callable[[], object]):
     """The map cached as ``kind``/``key`` when its entry checks out (``read_entry``), else ``build()``'s result,
     stored (a damaged entry: rebuilt, with one warning line saying so)."""
@@ -219,9 +315,11 @@ def cached(kind: str, key: str, build: Callable[[], object]):
         else:
             with contextlib.suppress(OSError):  # a read-only cache still serves
                 os.utime(path)  # a hit: most recently used now
+            _served(kind, "cache")
             return result
     limit = cache_limit()  # a bad $WGPUVIEWER_CACHE_MAX is a user error before the work, not after it
     result = build()
+    _served(kind, "built")
     try:
         with atomic_open(path) as f:
             write_entry(f, key, result)
@@ -233,9 +331,13 @@ def cached(kind: str, key: str, build: Callable[[], object]):
 
 
 def cached_generate(kind: str, height, backend: str = "auto", **options):
-    """Like :func:`maptools.generate`, but returns a cached result when the same input was seen before."""
+    """Like :func:`maptools.generate`, but returns a cached result when the same input was seen before, or the named
+    map of the kind inside ``serving``."""
     opts = get_kind(kind).resolve(options)
     h = validate_height(height)
+    named = (_named.get() or {}).get(kind)
+    if named is not None:
+        return named_map(kind, *named, h.shape, opts)
     return cached(kind, cache_key(kind, h, opts), lambda: generate(kind, h, backend=backend, **opts))
 
 

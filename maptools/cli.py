@@ -17,13 +17,28 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from wgpuviewer.core.cli import OneLineParser, prepare_process, run_command, save_traceback
-from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.errors import FileError, UserError
 from wgpuviewer.core.images import HEIGHT_CHANNELS, NAN_POLICIES, read_height
-from wgpuviewer.core.io import atomic_open, output_dir, refuse_directory, remove_stale_temps
+from wgpuviewer.core.io import output_dir, refuse_directory, remove_stale_temps
+from wgpuviewer.core.sidecar import MapRecord, file_sha256, is_recorded, read_record, record_path, write_record
 
 from . import VERSION, generate, resolve_backend
 from .io import INPUT_EXTS, write_result
 from .registry import KINDS, get_kind
+
+#: What a height-map input may be (core.images reads them).
+INPUT_HELP = "8/16-bit PNG, JPEG, TIFF, EXR or a float .npy array in [0, 1]"
+
+
+def _version() -> str:
+    """maptools' version: the installed wgpuviewer distribution's, and the CPU references' (part of every map key)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        installed = version("wgpuviewer")
+    except PackageNotFoundError:
+        installed = "(not installed: pip install -e . in the checkout)"
+    return f"{installed} (wgpuviewer distribution; CPU references {VERSION})"
 
 
 def _flag(name: str) -> str:
@@ -32,14 +47,17 @@ def _flag(name: str) -> str:
 
 def _add_input_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--channel", default="auto", choices=HEIGHT_CHANNELS,
-                   help="channel of a colour input (auto: a grey file as it is, a colour one as its Rec. 709 luma)")
+                   help="channel of a colour input (default %(default)s: a grey file as it is, a colour one as its "
+                   "Rec. 709 luma; grey: refuse a colour file; r, g, b, a: that channel; luma: Rec. 709 luma)")
     p.add_argument("--nan-policy", default="error", choices=NAN_POLICIES,
-                   help="NaN/inf texels: error (refuse), zero, nearest (nearest finite texel)")
+                   help="NaN/inf texels (float inputs): error (refuse), zero, nearest (the nearest finite texel's "
+                   "value); default %(default)s")
 
 
 def _add_backend(p: argparse.ArgumentParser) -> None:
     p.add_argument("--backend", default="auto", choices=("auto", "gpu", "cpu"),
-                   help="auto: GPU when an adapter exists, else CPU")
+                   help="where the maps are computed: gpu, cpu (the OpenCV/numpy reference), or auto (default): the "
+                   "GPU when an adapter exists, else the CPU")
 
 
 def _parse_kinds(text: str | None) -> list[str]:
@@ -79,39 +97,47 @@ def kind_options(kinds: list[str], items: list[str] | None) -> dict[str, dict]:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = OneLineParser(prog="maptools", description="Generate maps derived from height maps.")
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     gen = sub.add_parser("generate", help="generate one map from one height map")
     gen_kinds = gen.add_subparsers(dest="kind", required=True, metavar="KIND")
     for kind in KINDS.values():
         kp = gen_kinds.add_parser(kind.name, help=kind.description, description=kind.description)
-        kp.add_argument("input", metavar="INPUT", help="height map: .png (8/16-bit) or float .npy")
+        kp.add_argument("input", metavar="INPUT", help=f"height map file ({INPUT_HELP})")
         kp.add_argument("-o", "--output", required=True, metavar="OUT",
                         help=f"output file ({', '.join(kind.extensions)})")
         _add_backend(kp)
         _add_input_options(kp)
-        kp.add_argument("--bits", type=int, default=8, choices=(8, 16), help="PNG bit depth")
+        kp.add_argument("--bits", type=int, default=8, choices=(8, 16), help="PNG bit depth (default %(default)s)")
         for opt in kind.options:
             kp.add_argument(_flag(opt.name), dest=f"opt_{opt.name}", default=None, metavar=opt.name.upper(),
                             choices=opt.choices and [str(c) for c in opt.choices],
                             help=f"{opt.help} (default {opt.default})")
 
     bat = sub.add_parser("batch", help="generate maps for many height maps (files and folders)")
-    bat.add_argument("inputs", nargs="+", metavar="INPUT")
-    bat.add_argument("-o", "--output", required=True, metavar="DIR")
+    bat.add_argument("inputs", nargs="+", metavar="INPUT",
+                     help=f"height map files ({INPUT_HELP}) and folders (searched recursively for "
+                     f"{', '.join(INPUT_EXTS)} files; maps this tool wrote are skipped)")
+    bat.add_argument("-o", "--output", required=True, metavar="DIR",
+                     help="output folder (created if missing): INPUT_STEM.KIND.EXT per map, each with a "
+                     "INPUT_STEM.KIND.EXT.json sidecar recording its source and options (reruns skip up-to-date maps)")
     bat.add_argument("--kinds", default=None, help=f"comma-separated kinds (default all: {','.join(KINDS)})")
-    bat.add_argument("--jobs", type=int, default=1, help="worker threads (GPU work is serialised)")
+    bat.add_argument("--jobs", type=int, default=1,
+                     help="worker threads reading and writing files (default %(default)s; GPU work is serialised)")
     bat.add_argument("--shard", default=None, metavar="I/N", help="process only sorted inputs i with i %% N == I")
     bat.add_argument("--force", action="store_true", help="regenerate even when outputs are up to date")
-    bat.add_argument("--set", action="append", metavar="KIND.OPTION=VALUE", help="kind option (repeatable)")
-    bat.add_argument("--bits", type=int, default=8, choices=(8, 16), help="PNG bit depth")
+    bat.add_argument("--set", action="append", metavar="KIND.OPTION=VALUE",
+                     help="a kind's option, e.g. complexity.levels=16 (repeatable; `maptools kinds` lists them)")
+    bat.add_argument("--bits", type=int, default=8, choices=(8, 16), help="PNG bit depth (default %(default)s)")
     _add_backend(bat)
     _add_input_options(bat)
 
     chk = sub.add_parser("check", help="run GPU and CPU paths and compare them against each kind's tolerance")
-    chk.add_argument("input", metavar="INPUT")
+    chk.add_argument("input", metavar="INPUT", help=f"height map file ({INPUT_HELP})")
     chk.add_argument("--kinds", default=None, help="comma-separated kinds (default all)")
-    chk.add_argument("--set", action="append", metavar="KIND.OPTION=VALUE", help="kind option (repeatable)")
+    chk.add_argument("--set", action="append", metavar="KIND.OPTION=VALUE",
+                     help="a kind's option, e.g. complexity.levels=16 (repeatable; `maptools kinds` lists them)")
     _add_input_options(chk)
 
     sub.add_parser("kinds", help="list the map kinds and their options")
@@ -124,11 +150,16 @@ def build_parser() -> argparse.ArgumentParser:
 
     ben = sub.add_parser("bench", help="GPU vs CPU time per kind and size, side by side (one run, same machine)")
     ben.add_argument("--kinds", default=None, help="comma-separated kinds (default all)")
-    ben.add_argument("--sizes", default="64,256,1024", help="square sizes for the 2D kinds")
-    ben.add_argument("--volume-sizes", default="32,64,128", help="square sizes for distance (slices 16)")
-    ben.add_argument("--refined-sizes", default="32,64", help="square sizes for distance_refined (slices 8)")
-    ben.add_argument("--cone-sizes", default="64,128", help="square sizes for cone (max_ratio 16)")
-    ben.add_argument("--repeat", type=int, default=3, help="timed runs per cell (best is reported)")
+    ben.add_argument("--sizes", default="64,256,1024",
+                     help="comma-separated square sizes for the 2D kinds (default %(default)s)")
+    ben.add_argument("--volume-sizes", default="32,64,128",
+                     help="comma-separated square sizes for distance, 16 slices (default %(default)s)")
+    ben.add_argument("--refined-sizes", default="32,64",
+                     help="comma-separated square sizes for distance_refined, 8 slices (default %(default)s)")
+    ben.add_argument("--cone-sizes", default="64,128",
+                     help="comma-separated square sizes for cone, max_ratio 16 (default %(default)s)")
+    ben.add_argument("--repeat", type=int, default=3,
+                     help="timed runs per cell, the best is reported (default %(default)s)")
     return parser
 
 
@@ -158,14 +189,11 @@ def _output_name(f: Path) -> bool:
 
 
 def is_output(f: Path, folder: Path, outdir: Path | None) -> bool:
-    """A map this tool wrote, found while searching input ``folder``: it has a batch sidecar (``NAME.json``
-    written by maptools), or it lies in the output folder and is named like an output, or the output folder lies inside
-    ``folder`` (then nothing in it is an input)."""
-    try:
-        if str(json.loads(sidecar(f).read_text()).get("version", "")).startswith("maptools-"):
-            return True
-    except (OSError, ValueError, TypeError, AttributeError):
-        pass
+    """A map this tool wrote, found while searching input ``folder``: it has a batch record (``NAME.json``,
+    ``wgpuviewer.core.sidecar``), or it lies in the output folder and is named like an output, or the output folder
+    lies inside ``folder`` (then nothing in it is an input)."""
+    if is_recorded(f):
+        return True
     if outdir is None:
         return False
     out, here = outdir.resolve(), f.resolve()
@@ -215,14 +243,11 @@ def job_key(digest: str, kind: str, opts: dict, args, ext: str) -> str:
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
-def sidecar(out: Path) -> Path:
-    return out.with_name(out.name + ".json")
-
-
 def up_to_date(out: Path, key: str) -> bool:
+    """``out`` exists and its record names this job (an older record's layout: not up to date)."""
     try:
-        return out.is_file() and json.loads(sidecar(out).read_text())["key"] == key
-    except (OSError, ValueError, KeyError, TypeError):
+        return out.is_file() and read_record(out).key == key
+    except FileError:
         return False
 
 
@@ -274,16 +299,15 @@ def cmd_batch(args) -> int:
                 if not args.force and up_to_date(out, key):
                     res.append((str(f), k, "skipped", "up to date"))
                     continue
-                for owned in (out, sidecar(out)):  # left by a killed earlier run: this job owns both
+                for owned in (out, record_path(out)):  # left by a killed earlier run: this job owns both
                     remove_stale_temps(owned)
                 if height is None:
                     height = read_height(f, args.channel, args.nan_policy)
                 result = generate(k, height, backend=backend, **kopts[k])
                 write_result(kind, result, out, args.bits)
-                with atomic_open(sidecar(out)) as fh:
-                    fh.write(json.dumps({"key": key, "input": str(f), "input_sha256": digest, "kind": k,
-                                         "options": kopts[k], "version": VERSION,
-                                         "kernels": kind.source_hash()}, sort_keys=True).encode())
+                write_record(out, MapRecord(key=key, kind=k, options=kopts[k], version=VERSION,
+                                            kernels=kind.source_hash(), input=str(f), input_sha256=digest,
+                                            channel=args.channel, output_sha256=file_sha256(out)))
                 res.append((str(f), k, "ok", f"{out.name} ({time.perf_counter() - t0:.2f} s, {backend})"))
             except UserError as exc:
                 res.append((str(f), k, "FAILED", str(exc)))

@@ -1,8 +1,9 @@
-"""Checking height arrays and writing maps (atomically, through ``wgpuviewer.core.io.atomic_open``). Height
-files are read by ``wgpuviewer.core.images.read_height``, the reader scenes use too."""
+"""Checking height arrays, writing maps (atomically, through ``wgpuviewer.core.io.atomic_open``) and reading back the
+maps a scene may name. Height files are read by ``wgpuviewer.core.images.read_height``, the reader scenes use too."""
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import cv2
@@ -95,6 +96,37 @@ def write_result(kind, result, path, bits: int = 8) -> Path:
     with atomic_open(path) as f:
         kind.writer(f, result, ext, bits)
     return path
+
+
+#: The maps a file can stand in for (a scene's ``[materials.X.maps]``): kind -> (dimensions, dtype) of the array it
+#: holds as written (``write_complexity``, ``write_volume``, ``write_cone``).
+READABLE = {"complexity": (2, np.uint8), "distance": (3, np.float32), "distance_refined": (4, np.float16),
+            "cone": (2, np.float32)}
+
+
+def read_map(kind: str, data: bytes, ext: str) -> np.ndarray:
+    """The map of ``kind`` in a file's bytes ``data`` (extension ``ext``), as the kind's generator returns it: a
+    complexity PNG's levels (16-bit: value / 257), a cone PNG decoded (``cone.decode_png``: never a wider cone), a
+    .npy array as saved. A UserError says what the bytes hold instead."""
+    dims, dtype = READABLE[kind]
+    if ext == ".npy":
+        try:
+            a = np.load(io.BytesIO(data), allow_pickle=False)
+        except (ValueError, OSError, EOFError) as error:
+            raise UserError(f"not a readable .npy array ({error})") from None
+    else:
+        a = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
+        if a is None or a.ndim != 2 or a.dtype not in (np.uint8, np.uint16):
+            raise UserError("not a grey 8- or 16-bit PNG")
+        if kind == "cone":
+            from .cone import decode_png
+
+            a = decode_png(a)
+        elif a.dtype == np.uint16:
+            a = (a // 257).astype(np.uint8)
+    if a.ndim != dims or a.dtype != dtype:
+        raise UserError(f"holds a {a.dtype} array of shape {a.shape}; a {kind} map is {dims}-D {np.dtype(dtype)}")
+    return a
 
 
 def read_maxmip(path) -> list[np.ndarray]:

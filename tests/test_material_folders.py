@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 import pytest
 
-from tests.core.test_images import huge_exr
+from tests.core.test_images import EXR_UINT, huge_exr
 from wgpuviewer import cli, textures
 from wgpuviewer.core.errors import FileError, InputError, UserError
 from wgpuviewer.scene import default_scene_path, load_scene, with_folder_material
@@ -139,11 +139,9 @@ def test_ambiguous_and_empty_folders_are_clear_errors(tmp_path):
 def test_a_file_the_reader_cannot_read_is_named_with_the_folder_key(tmp_path):
     folder = make_folder(tmp_path, "polyhaven")
     (folder / "rock_wall_disp_1k.png").unlink()
-    huge_exr(folder / "rock_wall_disp_1k.exr", SIZE, SIZE)  # a float displacement, as Poly Haven ships it
-    if cv2.haveImageReader(str(folder / "rock_wall_disp_1k.exr")):
-        pytest.skip("this OpenCV reads EXR")
-    with pytest.raises(UserError, match=r"--material .*polyhaven: rock_wall_disp_1k.exr: this OpenCV build cannot "
-                                        r"read EXR; convert it to a 16-bit PNG or .npy"):
+    huge_exr(folder / "rock_wall_disp_1k.exr", SIZE, SIZE, channels=(("Y", EXR_UINT, 1),))  # an integer channel
+    with pytest.raises(UserError, match=r"--material .*polyhaven: rock_wall_disp_1k.exr: EXR channel 'Y' holds UINT "
+                                        r"values; expected HALF or FLOAT"):
         with_folder_material(load_scene(default_scene_path()), folder)
 
 
@@ -242,4 +240,27 @@ def test_an_unusable_entry_named_for_a_slot_is_an_error_naming_it(tmp_path, caps
         (folder / name).unlink()
     (folder / "albedo.png").symlink_to("nowhere.png")
     with pytest.raises(FileError, match="albedo.png: broken link to nowhere.png"):
+        find_material_files(folder)
+
+
+def test_maps_maptools_batch_wrote_into_the_folder_are_not_the_sets_textures(tmp_path, capsys):
+    """A batch run on the displacement with the folder as output puts X_Displacement.normal.png (a normal map by
+    name), .complexity.png and .cone.png (height maps by name) next to the set: each has its record, so the scan
+    takes the set's own files, and an output whose record is gone is a candidate again."""
+    from maptools import cli as maptools_cli
+
+    folder = make_folder(tmp_path, "ambientcg")
+    displacement = folder / "Rock042_1K-PNG_Displacement.png"
+    assert maptools_cli.main(["batch", str(displacement), "-o", str(folder), "--kinds", "normal,complexity,cone",
+                              "--backend", "cpu"]) == 0
+    outputs = sorted(p.name for p in folder.glob("*_Displacement.*.*") if p.suffix != ".json")
+    assert outputs == ["Rock042_1K-PNG_Displacement.complexity.png", "Rock042_1K-PNG_Displacement.cone.npy",
+                       "Rock042_1K-PNG_Displacement.normal.png"]
+    found = find_material_files(folder)
+    assert (found.albedo.name, found.normal.name, found.normal_y, found.height.name) == EXPECTED["ambientcg"]
+    material = with_folder_material(load_scene(default_scene_path()), folder).materials["folder ambientcg"]
+    assert (material.normal.path, material.height.path) == (folder / "Rock042_1K-PNG_NormalGL.png", displacement)
+    (folder / "Rock042_1K-PNG_Displacement.normal.png.json").unlink()
+    with pytest.raises(FileError, match="2 candidates for the normal: Rock042_1K-PNG_Displacement.normal.png, "
+                                        "Rock042_1K-PNG_NormalGL.png"):
         find_material_files(folder)

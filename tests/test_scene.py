@@ -453,3 +453,71 @@ def test_a_material_folder_keeps_the_scenes_tiling_only_where_float32_can(tmp_pa
     with pytest.raises(UserError, match=r"--material .*rock: the scene's uv_scale = \[40000.0, 1.0\] is out of "
                                         r"range for its 512x512 texture"):
         with_folder_material(scene, folder)
+
+
+# --- precomputed maps: [materials.X.maps] ------------------------------------------------------------------------
+
+MAPS_MATERIAL = """
+[materials.rock]
+albedo = [0.5, 0.4, 0.3]
+height = "h.npy"
+[materials.rock.maps]
+cone = "maps/h.cone.npy"
+complexity = "maps/h.complexity.png"
+"""
+
+
+def batch_maps(tmp_path: Path) -> np.ndarray:
+    """h.npy (8x8) and its cone and complexity maps in maps/, as maptools batch writes them; the height."""
+    from maptools import cli as maptools_cli
+
+    height = (np.indices((8, 8)).sum(axis=0) % 5 / 4).astype(np.float32)
+    np.save(tmp_path / "h.npy", height)
+    assert maptools_cli.main(["batch", str(tmp_path / "h.npy"), "-o", str(tmp_path / "maps"), "--kinds",
+                              "cone,complexity", "--backend", "cpu"]) == 0
+    return height
+
+
+def test_a_material_names_maps_that_maptools_batch_built_from_its_height(tmp_path, capsys):
+    batch_maps(tmp_path)
+    material = load(tmp_path, scene_text(material=MAPS_MATERIAL)).materials["rock"]
+    assert [(slot, ref.path) for slot, ref in material.maps] == [("cone", tmp_path / "maps" / "h.cone.npy"),
+                                                                 ("complexity", tmp_path / "maps" / "h.complexity.png")]
+    assert material.maps[0][1].origin == f"{tmp_path / 'x.toml'}: materials.rock.maps.cone = 'maps/h.cone.npy'"
+    assert load(tmp_path, scene_text(material=MATERIAL)).materials["rock"].maps == ()
+
+
+@pytest.mark.parametrize("case,replace,parts", [
+    ("slot", ('cone = "maps/h.cone.npy"', 'maxmip = "maps/h.maxmip.npz"'),
+     ["materials.rock.maps.maxmip = 'maps/h.maxmip.npz': unknown key; allowed: complexity, distance, "
+      "distance_refined, cone"]),
+    ("type", ('cone = "maps/h.cone.npy"', "cone = 3"),
+     ["materials.rock.maps.cone = 3: expected the path of a cone map written by maptools batch"]),
+    ("table", ('[materials.rock.maps]\ncone = "maps/h.cone.npy"\ncomplexity = "maps/h.complexity.png"',
+               'maps = "maps"'), ["materials.rock.maps = 'maps': expected a table"]),
+    ("builtin", ('height = "h.npy"', 'height = "builtin:bumps"'),
+     ["materials.rock.maps.cone = 'maps/h.cone.npy': the material has no height file to check the map against"]),
+    ("depth", ('height = "h.npy"', 'depth = "h.npy"'),
+     ["materials.rock.maps.cone", "reads its file as depth; give the height file as height"]),
+    ("missing", ('cone = "maps/h.cone.npy"', 'cone = "maps/gone.npy"'),
+     ["materials.rock.maps.cone = 'maps/gone.npy': file not found (looked for"]),
+    ("no record", ('cone = "maps/h.cone.npy"', 'cone = "copy.npy"'),
+     ["materials.rock.maps.cone = 'copy.npy': copy.npy.json not found; name a map written by maptools batch"]),
+    ("kind", ('cone = "maps/h.cone.npy"', 'cone = "maps/h.complexity.png"'),
+     ["materials.rock.maps.cone = 'maps/h.complexity.png': is a complexity map (its record says so); expected a "
+      "cone map"]),
+    ("other height", None,
+     ["materials.rock.maps.cone = 'maps/h.cone.npy': built from", "h.npy (sha256 ", "not from this material's "
+      "height", "rebuild it: maptools batch", "--kinds cone"]),
+    ("channel", ('height = "h.npy"', 'height = "h.npy"\nchannel = "r"'),
+     ["materials.rock.maps.cone = 'maps/h.cone.npy': built from channel auto of the height file, and this material "
+      "reads channel r; rebuild it with --channel r"]),
+])
+def test_a_named_map_not_built_from_the_materials_height_is_refused_naming_the_key(tmp_path, case, replace, parts):
+    height = batch_maps(tmp_path)
+    (tmp_path / "copy.npy").write_bytes((tmp_path / "maps" / "h.cone.npy").read_bytes())
+    if case == "other height":
+        np.save(tmp_path / "h.npy", height[::-1].copy())
+    text = MAPS_MATERIAL if replace is None else MAPS_MATERIAL.replace(*replace)
+    assert text != MAPS_MATERIAL or replace is None
+    error(tmp_path, scene_text(material=text), *parts)

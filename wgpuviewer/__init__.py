@@ -1,11 +1,39 @@
 """wgpuviewer: relief-mapping techniques on WebGPU, compared honestly (docs/architecture.md maps the rooms).
 
+From Python (``api``; docs/usage.md)::
+
+    import wgpuviewer
+
+    image = wgpuviewer.render(technique="pom", size=(320, 180), camera={"view_angle": 70})  # (180, 320, 3)
+    depth = wgpuviewer.render("scenes/default.toml", "relief", (320, 180), mode="depth")
+    widget = wgpuviewer.view()  # the viewer in a Jupyter notebook
+
 - ``core/``: errors, GPU, atomic I/O, the image reader, CPU sampling, colour, the WGSL composer (imports nothing
   else of the project);
 - ``scene.py``, ``textures.py``, ``meshes.py``, ``camera.py``: scenes and what they are made of;
 - ``relief/``: techniques, maps, shaders, renderer, probe, float64 reference, accuracy;
-- ``viewer/``, ``bench/``, ``studies/``: the window, the benchmark, the studies (each imported only by ``cli``);
-- ``probe.py``, ``reference.py``, ``accuracy.py``: the documented API, re-exported from ``relief/``.
+- ``viewer/``, ``bench/``, ``studies/``: the window, the benchmark, the studies (each imported only by ``cli``,
+  the viewer also by ``api``'s ``view``);
+- ``api.py``: ``render``, ``view``, ``CameraSpec`` (exported here), and the camera and relief settings the
+  ``render`` command shares with them;
+- ``probe.py``, ``reference.py``, ``accuracy.py``: the documented API, re-exported from ``relief/``;
+- ``gpusuite.py``: ``./dev gpu-suite``, bench and the studies within one time budget, and the README's headline.
 
 The scene modules may import ``core`` and ``relief.techniques`` (scenes name techniques and their parameters).
+This package imports ``api`` on first use of a name it exports, so importing any module of it (``core.cli``,
+before a GPU driver or OpenCV loads) stays cheap.
 """
+
+__all__ = ["CameraSpec", "render", "view"]
+
+
+def __getattr__(name: str):
+    if name in __all__:
+        from . import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'wgpuviewer' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted({*globals(), *__all__})

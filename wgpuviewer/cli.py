@@ -1,4 +1,4 @@
-"""Command line: ``wgpuviewer view|render|techniques|filters|accuracy|info`` here, and the measuring commands:
+"""Command line: ``wgpuviewer view|render|warm|techniques|filters|accuracy|info`` here, and the measuring commands:
 ``bench`` and every study under ``wgpuviewer/studies/`` (found by the harness, each registering itself)."""
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from pathlib import Path
 from wgpuviewer.core.cli import (
     OneLineParser,
     add_backend_option,
+    comma_numbers,
     command_line,
     parse_size,
     prepare_process,
@@ -22,6 +23,14 @@ from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import refuse_directory
 
 DEFAULT_SIZE = (1280, 720)
+#: What `render`'s --height-scale, --uv-scale and --view-angle are about (wgpuviewer.api.subject).
+SUBJECT = "the scene's first plane (where --material shows its folder), or its first object when it has no plane"
+SUBJECT_MATERIAL = f"the material of {SUBJECT}"
+VIEW_ANGLE_HELP = (f"place the camera so that its view meets the surface of {SUBJECT} (a box: its top face; a quad: "
+                   "its front) at DEG degrees from the surface normal: 0 looks straight down onto it, 90 would graze "
+                   "it (0 <= DEG < 90). The camera looks at the target (--target, or the scene camera's) from the "
+                   "scene camera's distance to it, on the side of the surface the scene camera sees it from; "
+                   "not with --camera")
 MATERIAL_HELP = ("a material folder (ambientCG, Poly Haven or albedo/normal/height names) shown on the scene's "
                  "first plane; without SCENE, the default scene's")
 
@@ -52,13 +61,10 @@ def has_display() -> bool:
     return True
 
 
-def render_to(out: Path, scene, technique: str, size: tuple[int, int], mode: str, backend: str | None,
-              filtering: dict) -> None:
-    """Render ``scene`` offscreen into ``out`` (.png or .npy), the maps it needs built first with a progress bar;
-    ``filtering``: the texture filter and derivative source (``pick_filtering``). A frame too large for the adapter
-    is refused (naming ``--size``) before any map is built."""
+def prepared_renderer(scene, technique: str, size: tuple[int, int], backend: str | None):
+    """A Renderer of ``scene`` with the maps ``technique`` needs built (a progress bar); a frame of ``size`` too large
+    for the adapter is refused (naming ``--size``) before any map is built."""
     from wgpuviewer.core.gpu import get_gpu
-    from wgpuviewer.relief.output import save_output
     from wgpuviewer.relief.renderer import Renderer, check_frame_size
 
     gpu = get_gpu(backend)
@@ -66,8 +72,20 @@ def render_to(out: Path, scene, technique: str, size: tuple[int, int], mode: str
     renderer = Renderer(scene, gpu)
     with terminal_progress(f"maps for {technique}") as progress:
         renderer.prepare(technique, progress)
-    image = renderer.render(renderer.config(technique, **filtering), size, mode=mode, size_name="--size")
-    save_output(out, image, mode)
+    return renderer
+
+
+def render_to(out: Path, scene, technique: str, size: tuple[int, int], mode: str, backend: str | None,
+              filtering: dict, camera=None, alpha: bool = False) -> None:
+    """Render ``scene`` offscreen into ``out`` (.png or .npy), the maps it needs built first with a progress bar;
+    ``filtering``: the texture filter and derivative source (``pick_filtering``); ``camera``: the scene's when None
+    (``render_view``); ``alpha``: transparent where nothing was drawn (``relief.output``). A frame too large for the
+    adapter is refused (naming ``--size``) before any map is built."""
+    from wgpuviewer.relief.output import save_output
+
+    renderer = prepared_renderer(scene, technique, size, backend)
+    image = renderer.render(renderer.config(technique, **filtering), size, camera, mode=mode, size_name="--size")
+    save_output(out, image, mode, alpha)
 
 
 def cmd_render(args) -> int:
@@ -75,14 +93,69 @@ def cmd_render(args) -> int:
 
     out = Path(args.output)
     refuse_directory(out, "render.png")
-    if out.suffix.lower() not in OUTPUT_SUFFIXES:
-        raise UserError(f"-o {out}: unknown output type {out.suffix!r}; use .png (image) or .npy (raw float32 data)")
-    scene = scene_from_args(args)
-    technique = pick_technique(scene, args.technique)
     size = parse_size(args.size) if args.size else DEFAULT_SIZE
-    render_to(out, scene, technique, size, args.mode, args.backend, pick_filtering(args))
+    if args.alpha and args.orbit is not None:
+        raise UserError(f"--alpha: a turntable ({out.suffix}) has no alpha; drop --alpha or render single frames to "
+                        ".png")
+    if args.orbit is not None:
+        from wgpuviewer.relief.turntable import check_turntable
+
+        check_turntable(out, args.orbit, size)
+    elif out.suffix.lower() not in OUTPUT_SUFFIXES:
+        raise UserError(f"-o {out}: unknown output type {out.suffix!r}; use .png (image) or .npy (raw float32 data), "
+                        "or .gif or .mp4 with --orbit N")
+    scene, camera = render_view(args, scene_from_args(args))
+    technique = pick_technique(scene, args.technique)
+    if args.orbit is not None:
+        render_orbit(out, scene, technique, size, args.mode, args.backend, pick_filtering(args), camera, args.orbit)
+    else:
+        render_to(out, scene, technique, size, args.mode, args.backend, pick_filtering(args), camera, args.alpha)
     print(out)
     return 0
+
+
+def render_orbit(out: Path, scene, technique: str, size: tuple[int, int], mode: str, backend: str | None,
+                 filtering: dict, camera, frames: int) -> None:
+    """A turntable (``relief.turntable``): ``frames`` renders of one turn of ``camera`` about its target, written to
+    ``out`` (.gif or .mp4, checked by ``check_turntable`` first)."""
+    from tqdm import tqdm
+
+    from wgpuviewer.relief.turntable import turntable_pictures, write_turntable
+
+    renderer = prepared_renderer(scene, technique, size, backend)
+    with tqdm(total=frames, desc="turntable", unit="frame", file=sys.stderr, disable=None, leave=False) as bar:
+        pictures = turntable_pictures(renderer, renderer.config(technique, **filtering), camera or scene.camera,
+                                      size, frames, mode, progress=lambda done, total: bar.update(1))
+        write_turntable(out, pictures, size)
+
+
+#: The names `render`'s messages give the settings it shares with the Python API (wgpuviewer.api).
+RENDER_OPTIONS = {"position": "--camera", "target": "--target", "fov": "--fov", "view_angle": "--view-angle",
+                  "height_scale": "--height-scale", "uv_scale": "--uv-scale"}
+
+
+def render_view(args, scene):
+    """The scene with ``--height-scale``/``--uv-scale`` applied and the camera of ``--camera``, ``--target``,
+    ``--fov`` and ``--view-angle``: built and checked by the Python API's functions (``api.with_relief``,
+    ``api.camera_for``), so a render from the command line and one from Python agree."""
+    from wgpuviewer.api import CameraSpec, camera_for, with_relief
+
+    tiling = comma_numbers(args.uv_scale, "--uv-scale", "2 or 2,1")
+    if tiling is not None and len(tiling) not in (1, 2):
+        raise UserError(f"--uv-scale {args.uv_scale!r}: expected one number (both directions) or U,V, e.g. 2,1")
+    scene = with_relief(scene, args.height_scale, tiling if tiling is None or len(tiling) == 2 else tiling[0],
+                        RENDER_OPTIONS)
+    spec = CameraSpec(position=point_option(args.camera, "--camera"), target=point_option(args.target, "--target"),
+                      fov=args.fov, view_angle=args.view_angle)
+    return scene, camera_for(scene, spec, RENDER_OPTIONS)
+
+
+def point_option(text: str | None, option: str) -> tuple[float, float, float] | None:
+    """``X,Y,Z`` as three numbers (None when the option was not given)."""
+    numbers = comma_numbers(text, option, "0,1.4,3.2")
+    if numbers is not None and len(numbers) != 3:
+        raise UserError(f"{option} {text!r}: expected three numbers X,Y,Z, e.g. 0,1.4,3.2")
+    return None if numbers is None else tuple(numbers)
 
 
 def scene_from_args(args, fallback: str | None = None):
@@ -95,12 +168,18 @@ def scene_from_args(args, fallback: str | None = None):
 
 
 def cmd_view(args) -> int:
+    from wgpuviewer.viewer.runner import scripted_frames
     from wgpuviewer.viewer.settings import load_settings
 
-    scripted = args.frames is not None or bool(args.screenshot) or bool(args.keys)
+    keys = [k for k in args.keys.split(",") if k] if args.keys else []
+    # The script is checked first: before the scene loads, the GPU starts or a display is looked for.
+    scripted = scripted_frames(args.frames, args.screenshot, keys) is not None
+    window = has_display()
+    if keys and not window:
+        raise UserError(f"--keys {args.keys}: no display (DISPLAY/WAYLAND_DISPLAY unset) to play them in; run under "
+                        "one (e.g. xvfb-run -a wgpuviewer view ...), or drop --keys for an offscreen --screenshot")
     settings, _warnings = load_settings()  # corrupt/outdated file: defaults + a warning on stderr
     technique_arg = args.technique
-    window = has_display()
     last = settings.last_scene if window and not scripted and args.scene is None and not args.material else ""
     scene = None
     if last:  # interactive runs continue where the last one ended
@@ -119,18 +198,28 @@ def cmd_view(args) -> int:
     filtering = pick_filtering(args)
     size = parse_size(args.size) if args.size else None
     if not window:
-        out = Path("out") / f"{Path(scene.path).stem if scene.path else 'scene'}_{technique}.png"
-        print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the scene to {out} instead")
-        render_to(out, scene, technique, size or DEFAULT_SIZE, "color", args.backend, filtering)
-        print(out)
-        return 0
+        return view_offscreen(args, scene, technique, filtering, size or (settings.width, settings.height))
     from wgpuviewer.viewer.app import run_viewer
 
-    keys = [k for k in args.keys.split(",") if k] if args.keys else []
     return run_viewer(
         scene, technique, backend=args.backend, frames=args.frames, screenshot=args.screenshot, keys=keys,
         gui=args.gui, settings=settings, size=size, **filtering,
     )
+
+
+def view_offscreen(args, scene, technique: str, filtering: dict, size: tuple[int, int]) -> int:
+    """``view`` without a display: the scene the window would show, rendered offscreen at the window's size into
+    ``--screenshot`` (without the HUD), or into out/SCENE_TECHNIQUE.png when no screenshot was asked for."""
+    if args.screenshot:
+        out = Path(args.screenshot)
+        print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): writing {out} as an offscreen render of the scene "
+              "(no HUD)")
+    else:
+        out = Path("out") / f"{Path(scene.path).stem if scene.path else 'scene'}_{technique}.png"
+        print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the scene to {out} instead")
+    render_to(out, scene, technique, size, "color", args.backend, filtering)
+    print(out)
+    return 0
 
 
 def cmd_techniques(args) -> int:
@@ -211,6 +300,39 @@ def cmd_info(args) -> int:
     return 0
 
 
+def cmd_warm(args) -> int:
+    """Build every map the chosen techniques need on the scene (or a material folder) into the map cache; one line
+    per technique, exit 1 when one could not be built."""
+    from maptools.cache import cache_dir
+    from wgpuviewer.core.gpu import get_gpu
+    from wgpuviewer.relief.techniques import TECHNIQUES, get_technique
+    from wgpuviewer.relief.warm import warm
+
+    if args.scene and Path(args.scene).is_dir():  # SCENE|DIR: a folder is a material folder on the default scene
+        if args.material:
+            raise UserError(f"warm {args.scene}: a folder is a material folder; give it or --material, not both")
+        args.scene, args.material = None, args.scene
+    scene = scene_from_args(args)
+    if args.techniques is None:
+        techniques = scene.techniques
+    elif args.techniques.strip() == "all":
+        techniques = tuple(TECHNIQUES)
+    else:
+        names = [n.strip() for n in args.techniques.split(",") if n.strip()]
+        if not names:
+            raise UserError(f"--techniques {args.techniques!r}: expected technique names, e.g. pom,distance, or all")
+        techniques = tuple(dict.fromkeys(get_technique(n, "--techniques").name for n in names))
+    gpu = get_gpu(args.backend)
+    failed = 0
+    for technique in techniques:
+        with terminal_progress(f"maps for {technique}") as progress:
+            result = warm(scene, gpu, technique, progress)
+        failed += bool(result.error)
+        print(result.summary)
+    print(f"map cache: {cache_dir()}")
+    return 1 if failed else 0
+
+
 def add_filter_options(parser) -> None:
     from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER
 
@@ -233,11 +355,12 @@ def measurement_commands() -> list:
 def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
     """The parser and the names of its commands."""
     from wgpuviewer.harness.study import register
-    from wgpuviewer.relief.output import OUTPUT_MODES
+    from wgpuviewer.relief.output import MODE_DESCRIPTIONS, OUTPUT_MODES
 
     parser = OneLineParser(
         prog="wgpuviewer", description="Relief-mapping techniques on WebGPU: viewer, offscreen renderer, probe."
     )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {installed_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
     view = sub.add_parser("view", help="open the interactive viewer (renders a PNG when there is no display)")
@@ -245,8 +368,12 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
     view.add_argument("--technique", help="technique to start with (default: the scene's)")
     add_backend_option(view)
     view.add_argument("--frames", type=int, help="scripted run: draw this many frames, then exit")
-    view.add_argument("--screenshot", help="scripted run: save the last frame to this PNG")
-    view.add_argument("--keys", help="scripted run: comma-separated keys to press, one per frame (e.g. 2,3,ArrowRight)")
+    view.add_argument("--screenshot", metavar="PATH",
+                      help="scripted run: save the last frame to this PNG (no display: an offscreen render of the "
+                      "scene, without the HUD)")
+    view.add_argument("--keys", help="scripted run: comma-separated keys, one per frame (e.g. 2,3,ArrowRight), and the "
+                      "fly keys held for seconds of motion, W:0.5 (W A S D Q E, played at 30 frames per second: "
+                      "15 frames); needs a display")
     view.add_argument("--gui", choices=("glfw", "qt", "auto"), default="glfw",
                       help="window toolkit through rendercanvas (default glfw; qt needs PySide6/PyQt6)")
     view.add_argument("--size", help="window size WIDTHxHEIGHT in logical pixels (default: the saved size, 1280x720)")
@@ -256,14 +383,46 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
 
     render = sub.add_parser("render", help="render a scene offscreen to PNG or .npy")
     render.add_argument("scene", nargs="?", help="scene TOML (default: the built-in default scene)")
-    render.add_argument("-o", "--output", required=True, help="output file: .png (picture) or .npy (raw float32)")
+    render.add_argument("-o", "--output", required=True,
+                        help="output file: .png (picture) or .npy (raw float32); .gif or .mp4 with --orbit")
+    render.add_argument("--orbit", type=int, metavar="N",
+                        help="a turntable: N frames (2 to 3600) of one full turn of the camera about the vertical "
+                        "axis through its target, written to -o OUT.gif or OUT.mp4 at 25 frames per second "
+                        "(pip install 'wgpuviewer[turntable]')")
     render.add_argument("--technique", help="technique (default: the scene's)")
     render.add_argument("--size", help=f"WIDTHxHEIGHT (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
-    render.add_argument("--mode", choices=OUTPUT_MODES, default="color", help="what to write")
+    render.add_argument("--mode", choices=OUTPUT_MODES, default="color", metavar="MODE",
+                        help=f"what to write (default %(default)s): "
+                        f"{', '.join(f'{m} ({what})' for m, what in MODE_DESCRIPTIONS.items())}. A .npy holds the "
+                        "raw float32 values, NaN where nothing was drawn")
+    render.add_argument("--alpha", action="store_true",
+                        help="transparent background: an RGBA PNG whose alpha is 0 where nothing was drawn (color "
+                        "and albedo .npy get that as a fourth channel)")
     add_backend_option(render)
     render.add_argument("--material", metavar="DIR", help=MATERIAL_HELP)
+    render.add_argument("--camera", metavar="X,Y,Z",
+                        help="camera position (default: the scene camera's); a value starting with '-' needs '=': "
+                        "--camera=-1,0.5,2")
+    render.add_argument("--target", metavar="X,Y,Z", help="the point the camera looks at (default: the scene camera's)")
+    render.add_argument("--fov", type=float, metavar="DEG",
+                        help="vertical field of view in degrees, above 1 and below 179 (default: the scene camera's)")
+    render.add_argument("--view-angle", type=float, metavar="DEG", help=VIEW_ANGLE_HELP)
+    render.add_argument("--height-scale", type=float, metavar="H",
+                        help=f"relief depth in UV units, 0 to 1, of {SUBJECT_MATERIAL} (default: the material's)")
+    render.add_argument("--uv-scale", metavar="S|U,V",
+                        help=f"texture repeats across the object for {SUBJECT_MATERIAL}: one number for both "
+                        "directions or U,V (default: the material's)")
     add_filter_options(render)
     render.set_defaults(func=cmd_render)
+
+    warm_ = sub.add_parser("warm", help="build every map a scene's techniques need into the map cache, now")
+    warm_.add_argument("scene", nargs="?", metavar="SCENE|DIR",
+                       help="scene TOML, or a material folder shown on the default scene (default: the default scene)")
+    warm_.add_argument("--techniques", metavar="NAMES",
+                       help="comma-separated techniques, or all (default: the scene's techniques)")
+    warm_.add_argument("--material", metavar="DIR", help=MATERIAL_HELP)
+    add_backend_option(warm_)
+    warm_.set_defaults(func=cmd_warm)
 
     techniques = sub.add_parser("techniques", help="list techniques, their keys, needed maps and parameters")
     techniques.set_defaults(func=cmd_techniques)
@@ -272,10 +431,12 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
     filters.set_defaults(func=cmd_filters)
 
     accuracy = sub.add_parser("accuracy", help="probe each ray-search technique against the float64 reference")
-    accuracy.add_argument("--heightmaps", nargs="+", default=["bricks", "bumps", "checker"], help="builtin maps")
-    accuracy.add_argument("--texels", type=int, default=256, help="map size (square)")
-    accuracy.add_argument("--rays", type=int, default=4096, help="random rays per row")
-    accuracy.add_argument("--height-scale", type=float, default=0.05, help="relief depth in UV units")
+    accuracy.add_argument("--heightmaps", nargs="+", default=["bricks", "bumps", "checker"], metavar="NAME",
+                          help="builtin height maps to measure on (default: bricks bumps checker)")
+    accuracy.add_argument("--texels", type=int, default=256, help="map size in texels, square (default %(default)s)")
+    accuracy.add_argument("--rays", type=int, default=4096, help="random rays per row (default %(default)s)")
+    accuracy.add_argument("--height-scale", type=float, default=0.05,
+                          help="relief depth in UV units (default %(default)s)")
     add_backend_option(accuracy)
     accuracy.add_argument("--doc", metavar="PATH",
                           help="write the markdown report (docs/accuracy.md) to PATH instead of printing the table")
@@ -290,6 +451,16 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
     return parser, tuple(sub.choices)
 
 
+def installed_version() -> str:
+    """The installed wgpuviewer distribution's version (package metadata)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("wgpuviewer")
+    except PackageNotFoundError:
+        return "(not installed: pip install -e . in the checkout)"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Exit codes (wgpuviewer.core.cli): 0 ok, 1 a check failed, 2 a user error, 3 an internal error."""
     prepare_process("wgpuviewer")  # before any GPU driver loads
@@ -297,7 +468,8 @@ def main(argv: list[str] | None = None) -> int:
 
     def command() -> int:
         parser, commands = build_parser()
-        words = given if given and (given[0] in commands or given[0] in ("-h", "--help")) else ["view", *given]
+        words = given if given and (given[0] in commands or given[0] in ("-h", "--help", "--version")) \
+            else ["view", *given]
         args = parser.parse_args(words)  # `wgpuviewer [SCENE] [--technique ...]` means view
         args.command_line = command_line("wgpuviewer", words)  # what the reports record
         return args.func(args)

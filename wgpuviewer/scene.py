@@ -9,6 +9,7 @@ expected. ``scenes/default.toml`` documents the format.
 
 from __future__ import annotations
 
+import logging
 import math
 import tomllib
 from dataclasses import dataclass, replace
@@ -19,10 +20,22 @@ import numpy as np
 
 from wgpuviewer.core.errors import FileError, UserError
 from wgpuviewer.core.images import read_header
+from wgpuviewer.core.sidecar import file_sha256, is_recorded, read_record
 from wgpuviewer.relief.techniques import TECHNIQUES, get_technique, resolve_params
 
 from . import camera as cam
-from .textures import BUILTINS, FOLDER_SLOTS, MAX_BUILTIN_SIZE, TextureRef, find_material_files
+from .textures import (
+    BUILTINS,
+    FOLDER_EXTS,
+    FOLDER_SLOTS,
+    MAX_BUILTIN_SIZE,
+    FolderFiles,
+    TextureRef,
+    file_role,
+    find_material_files,
+)
+
+log = logging.getLogger("wgpuviewer.scene")
 
 Vec3 = tuple[float, float, float]
 
@@ -57,7 +70,10 @@ class Material:
     ``normal`` None means: derive normals from the height map if there is one, else flat.
     ``height_is_depth`` records that the scene gave ``depth`` (0 = top) rather than ``height``
     (1 = top); textures.load_height / load_depth take it as ``is_depth``. ``height_scale`` is the
-    relief depth in UV units; ``uv_scale`` tiles the textures.
+    relief depth in UV units; ``uv_scale`` tiles the textures and ``uv_offset`` then shifts them, in tiles
+    (glTF's KHR_texture_transform order: ``uv * uv_scale + uv_offset``). ``maps``: (slot, file) of the
+    precomputed maps the scene names (``[materials.X.maps]``), each checked against the height file it was built
+    from; the renderer serves them instead of building those slots (``maptools.cache.serving``).
     """
 
     name: str
@@ -68,6 +84,8 @@ class Material:
     height_is_depth: bool = False
     height_scale: float = 0.05
     uv_scale: tuple[float, float] = (1.0, 1.0)
+    uv_offset: tuple[float, float] = (0.0, 0.0)
+    maps: tuple[tuple[str, TextureRef], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -324,7 +342,8 @@ def _light(src: str, key: str, data) -> Light:
 
 def _material(src: str, name: str, data, base: Path) -> Material:
     t = _Table(src, f"materials.{name}", data,
-               ("folder", "albedo", "normal", "normal_y", "height", "depth", "height_scale", "uv_scale", "channel"))
+               ("folder", "albedo", "normal", "normal_y", "height", "depth", "height_scale", "uv_scale", "uv_offset",
+                "channel", "maps"))
     folder = _folder(t, base)
     albedo = _texture(t, "albedo", base, color_ok=True, required=folder is None) or (folder and folder["albedo"])
     if albedo is None:
@@ -351,7 +370,7 @@ def _material(src: str, name: str, data, base: Path) -> Material:
     problem = _texel_coordinate_problem(uv_scale, (albedo, normal, height))
     if problem:
         raise t.error("uv_scale", t.data.get("uv_scale", list(uv_scale)), problem)
-    return Material(
+    material = Material(
         name=name,
         albedo=albedo,
         normal=normal,
@@ -360,7 +379,58 @@ def _material(src: str, name: str, data, base: Path) -> Material:
         height_is_depth=is_depth,
         height_scale=t.number("height_scale", 0.05, 0, 1),
         uv_scale=uv_scale,
+        uv_offset=t.vector("uv_offset", 2, [0.0, 0.0]),  # any finite value: the renderer drops its whole tiles
+        maps=_named_maps(t, base, height, is_depth),
     )
+    if folder is not None:
+        report_folder(folder)
+    return material
+
+
+#: The slots a scene may name a precomputed map for (``[materials.X.maps]``, files ``maptools batch`` writes): those
+#: the renderer builds from the height map itself (maxmip and quadmax come from the bilinear cells' maxima; a normal
+#: map is named by ``normal = ...``).
+NAMED_MAPS = ("complexity", "distance", "distance_refined", "cone")
+
+
+def _named_maps(t: _Table, base: Path, height: TextureRef | None, is_depth: bool) -> tuple[tuple[str, TextureRef], ...]:
+    """``[materials.X.maps]`` SLOT = "FILE" (relative to the scene): each file's batch record (core.sidecar) must say
+    it is a map of that slot built from the material's height file (the same bytes, read through the same channel).
+    The renderer checks the rest (options, maptools version, the file's own bytes) when it serves the map."""
+    raw = t.get("maps", None, "")
+    if raw is None:
+        return ()
+    maps = _Table(t.src, t.path("maps"), raw, NAMED_MAPS)
+    named = []
+    height_sha256 = ""
+    for slot, value in maps.data.items():
+        if not isinstance(value, str):
+            raise maps.error(slot, value, f"expected the path of a {slot} map written by maptools batch")
+        if height is None or height.kind != "file":
+            raise maps.error(slot, value, "the material has no height file to check the map against; give "
+                                          "height = \"...\", the file the map was built from")
+        if is_depth:
+            raise maps.error(slot, value, "maptools batch builds maps from height files (1 = top), and this material "
+                                          "reads its file as depth; give the height file as height = \"...\"")
+        path = (base / Path(value).expanduser()).resolve()
+        if not path.is_file():
+            raise maps.error(slot, value, f"file not found (looked for {path})")
+        try:
+            record = read_record(path)
+        except FileError as error:
+            raise maps.error(slot, value, f"{Path(error.path).name} {error.reason}") from None
+        if record.kind != slot:
+            raise maps.error(slot, value, f"is a {record.kind} map (its record says so); expected a {slot} map")
+        height_sha256 = height_sha256 or file_sha256(height.path)
+        if record.input_sha256 != height_sha256:
+            raise maps.error(slot, value, f"built from {record.input} (sha256 {record.input_sha256[:12]}...), not "
+                                          f"from this material's height {height.path} (sha256 {height_sha256[:12]}...); "
+                                          f"rebuild it: maptools batch {height.path} -o {path.parent} --kinds {slot}")
+        if record.channel != height.channel:
+            raise maps.error(slot, value, f"built from channel {record.channel} of the height file, and this material "
+                                          f"reads channel {height.channel}; rebuild it with --channel {height.channel}")
+        named.append((slot, TextureRef("file", path=path, origin=f"{t.src}: {maps.path(slot)} = {_show(value)}")))
+    return tuple(named)
 
 
 def _texture_size(ref: TextureRef | None) -> tuple[int, int]:
@@ -386,6 +456,12 @@ def _texel_coordinate_problem(uv_scale: tuple[float, float], refs) -> str:
             f"[{most[0]:g}, {most[1]:g}]")
 
 
+def uv_scale_problem(material: Material, uv_scale: tuple[float, float]) -> str:
+    """Why tiling ``material``'s textures by ``uv_scale`` goes beyond MAX_TEXEL_COORDINATE ('' when it does not):
+    the check a scene's ``uv_scale`` passes, for a tiling given elsewhere (``render --uv-scale``, the Python API)."""
+    return _texel_coordinate_problem(uv_scale, (material.albedo, material.normal, material.height))
+
+
 def _folder(t: _Table, base: Path) -> dict | None:
     """``folder = "DIR"``: the material's files found by name (textures.find_material_files); None if absent."""
     value = t.get("folder", None, "a folder path")
@@ -409,7 +485,7 @@ def folder_refs(path: Path, where: str, named=()) -> dict:
     material folder ``path``; each file's header checked; problems are reported against ``where`` (and the file's
     name)."""
     found = find_material_files(path, named)
-    refs: dict = {"normal_y": found.normal_y}
+    refs: dict = {"normal_y": found.normal_y, "report": f"{where}: {folder_summary(path, found, named)}"}
     for slot in ("albedo", "normal", "height"):
         file = getattr(found, slot)
         refs[slot] = None
@@ -420,6 +496,57 @@ def folder_refs(path: Path, where: str, named=()) -> dict:
                 raise FileError(path, f"{file.name}: {error.reason}") from None
             refs[slot] = TextureRef("file", path=file, origin=f"{where} ({file.name})")
     return refs
+
+
+def folder_summary(path: Path, found: FolderFiles, named=()) -> str:
+    """What the material folder ``path`` gave each slot (``found``; ``named``: the slots the scene gives itself)
+    and every other entry with why it was left out, grouped by reason."""
+    picked = []
+    for slot in FOLDER_SLOTS:
+        file = getattr(found, slot)
+        convention = f" ({_CONVENTIONS[found.normal_y]})" if slot == "normal" else ""
+        picked.append(f"{slot} {file.name}{convention}" if file is not None
+                      else f"{slot} from the scene" if slot in named else f"{slot} none")
+    chosen = {getattr(found, slot) for slot in FOLDER_SLOTS}
+    ignored: dict[str, list[str]] = {}
+    for entry in sorted(path.iterdir()):
+        if entry not in chosen:
+            ignored.setdefault(_left_out_because(entry, found, named), []).append(entry.name)
+    left_out = "; ".join(f"{', '.join(names)} ({why})" for why, names in ignored.items())
+    return f"picked {', '.join(picked)}; " + (f"ignored {left_out}" if left_out else "nothing else in the folder")
+
+
+def _left_out_because(entry: Path, found: FolderFiles, named) -> str:
+    """Why the material-folder scan (``textures.find_material_files``) passed over ``entry``."""
+    if entry.is_dir():
+        return "a folder"
+    if entry.suffix.lower() not in FOLDER_EXTS:
+        return "not an image file"
+    if is_recorded(entry):
+        return "written by maptools batch"
+    role = file_role(entry)
+    if role is None:
+        return "no albedo, normal or height in its name"
+    if role[0] in named:
+        return f"the scene gives the {role[0]}"
+    if role[0] == "normal" and role[1] != found.normal_y:
+        return f"{_CONVENTIONS[role[1]]} normal map; the {_CONVENTIONS[found.normal_y]} one is used"
+    return "not used"
+
+
+_CONVENTIONS = {"opengl": "OpenGL", "directx": "DirectX"}
+
+
+#: The folder lines already printed (``report_folder``): once per folder and what it gave.
+_REPORTED: set[str] = set()
+
+
+def report_folder(refs: dict) -> None:
+    """Say once what a material folder gave (``folder_refs``' report), as a ``wgpuviewer.scene`` note (INFO): the
+    CLIs print those, so the user sees which files ``--material`` or ``folder =`` took and which it left out."""
+    if refs["report"] not in _REPORTED:
+        _REPORTED.add(refs["report"])
+        log.info(refs["report"])
 
 
 def with_folder_material(scene: Scene, folder: Path) -> Scene:
@@ -444,9 +571,11 @@ def with_folder_material(scene: Scene, folder: Path) -> Scene:
         raise UserError(f"{where}: the scene's uv_scale = {list(old.uv_scale)} is {problem}")
     name = f"folder {folder.name}"
     material = Material(name=name, albedo=refs["albedo"], normal=refs["normal"], normal_y=refs["normal_y"],
-                        height=refs["height"], height_scale=old.height_scale, uv_scale=old.uv_scale)
+                        height=refs["height"], height_scale=old.height_scale, uv_scale=old.uv_scale,
+                        uv_offset=old.uv_offset)
     objects = list(scene.objects)
     objects[plane] = replace(objects[plane], material=name)
+    report_folder(refs)
     return replace(scene, materials={**scene.materials, name: material}, objects=tuple(objects),
                    name=f"{scene.name} with {folder.name}")
 

@@ -21,6 +21,7 @@ import numpy as np
 from wgpuviewer.core.color import srgb_to_linear
 from wgpuviewer.core.errors import FileError, InputError, UserError
 from wgpuviewer.core.images import MAX_SIDE, link_problem, read_height, read_image
+from wgpuviewer.core.sidecar import is_recorded
 
 
 @dataclass(frozen=True)
@@ -364,8 +365,10 @@ def find_material_files(folder: Path, named: Collection[str] = ()) -> FolderFile
     ``named`` are those the scene gives next to ``folder`` (they win: the folder is not searched for them, and
     their slots are None here). Where a folder has both an OpenGL and a DirectX normal map (ambientCG ships both),
     the OpenGL one is taken; two candidates for one slot are an error listing them; an entry named for a slot that
-    is no readable file (a broken link, a link loop, a folder) is an error naming it, never skipped. Raises
-    FileError (reason: what was found and the fix)."""
+    is no readable file (a broken link, a link loop, a folder) is an error naming it, never skipped. Maps
+    ``maptools batch`` wrote into the folder (a file with its record ``NAME.json``, ``core.sidecar``) are left out:
+    ``X_Displacement.normal.png`` is derived from the height, not the set's normal map. Raises FileError (reason:
+    what was found and the fix)."""
     unknown = set(named) - set(FOLDER_SLOTS)
     if unknown:
         raise InputError(f"named {sorted(unknown)}: expected slots among {', '.join(FOLDER_SLOTS)}")
@@ -376,7 +379,7 @@ def find_material_files(folder: Path, named: Collection[str] = ()) -> FolderFile
     unusable = []
     for path in sorted(folder.iterdir()):
         role = file_role(path)
-        if role is None or role[0] not in searched:
+        if role is None or role[0] not in searched or is_recorded(path):  # maptools' maps are none of the textures
             continue
         problem = _entry_problem(path)
         if problem is None:

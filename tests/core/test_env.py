@@ -37,6 +37,7 @@ def test_a_bad_value_names_the_variable_the_value_and_the_fix(monkeypatch, varia
 
 
 def test_unset_and_empty_mean_the_default_and_paths_expand_the_home_folder(monkeypatch):
+    monkeypatch.delenv(env.WGPU_BACKEND.name, raising=False)
     for variable in env.VARIABLES:
         monkeypatch.delenv(variable.name, raising=False)
         assert variable.value() == variable.default
@@ -51,14 +52,59 @@ def test_unset_and_empty_mean_the_default_and_paths_expand_the_home_folder(monke
     assert gpu.resolve_backend(None) == "vulkan" and gpu.resolve_backend("gl") == "gl"
 
 
+@pytest.mark.parametrize("value,backend", [("Vulkan", "vulkan"), ("Metal", "metal"), ("D3D12", "dx12"),
+                                           ("OpenGL", "gl"), ("OpenGLES", "gl"), ("Undefined", "auto"),
+                                           (" vulkan ", "vulkan")])
+def test_wgpu_pys_variable_chooses_the_backend_when_ours_is_unset(monkeypatch, value, backend):
+    monkeypatch.delenv(env.BACKEND.name, raising=False)
+    monkeypatch.setenv(env.WGPU_BACKEND.name, value)
+    assert env.BACKEND.value() == backend == gpu.resolve_backend(None)
+    assert gpu.resolve_backend("gl") == "gl"  # --backend wins over both
+
+
+@pytest.mark.parametrize("value", ["Null", "WebGPU", "D3D11", "vulcan"])
+def test_a_wgpu_backend_we_do_not_run_on_is_refused_naming_wgpu_pys_variable(monkeypatch, value):
+    monkeypatch.delenv(env.BACKEND.name, raising=False)
+    monkeypatch.setenv(env.WGPU_BACKEND.name, value)
+    with pytest.raises(UserError) as error:
+        env.check_environment()
+    assert str(error.value).startswith(f"$WGPU_BACKEND_TYPE = {value!r}: expected one of Undefined, Vulkan, Metal, "
+                                       "D3D12, OpenGL, OpenGLES")
+
+
+def test_ours_wins_over_wgpu_pys_and_says_so_once_where_they_disagree(monkeypatch, caplog):
+    monkeypatch.setattr(env, "_NOTED", set())
+    monkeypatch.setenv(env.BACKEND.name, "gl")
+    for theirs, noted in (("OpenGL", False), ("Vulkan", True), ("Null", True)):  # a bad value of theirs: ignored
+        monkeypatch.setenv(env.WGPU_BACKEND.name, theirs)
+        caplog.clear()
+        for _ in range(3):
+            assert env.BACKEND.value() == "gl"
+            env.check_environment()
+        lines = [r.getMessage() for r in caplog.records if r.name == "wgpuviewer.env"]
+        assert lines == ([f"$WGPUVIEWER_BACKEND = 'gl' wins over $WGPU_BACKEND_TYPE = {theirs!r}; unset one of "
+                          "them to silence this"] if noted else []), theirs
+
+
+def test_the_cli_prints_the_notice_as_one_warning_line(monkeypatch, capsys):
+    monkeypatch.setattr(env, "_NOTED", set())
+    monkeypatch.setenv(env.BACKEND.name, "vulkan")
+    monkeypatch.setenv(env.WGPU_BACKEND.name, "Metal")
+    assert cli.main(["techniques"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["wgpuviewer: warning: $WGPUVIEWER_BACKEND = 'vulkan' wins over $WGPU_BACKEND_TYPE = 'Metal'; "
+                   "unset one of them to silence this"]
+
+
 def test_the_backend_names_are_the_gpu_modules():
     assert env.BACKEND_CHOICES == gpu.BACKEND_CHOICES
 
 
 @pytest.mark.parametrize("name,value", [("WGPUVIEWER_CACHE_MAX", "-1"), ("WGPUVIEWER_CACHE_MAX", "abc"),
-                                        ("WGPUVIEWER_BACKEND", "vulcan")])
+                                        ("WGPUVIEWER_BACKEND", "vulcan"), ("WGPU_BACKEND_TYPE", "Null")])
 def test_every_command_refuses_a_bad_variable_before_it_runs(tmp_path, monkeypatch, capsys, name, value):
     """`render` used to accept a bad cache cap whenever it built no map (and `cache info` refused it)."""
+    monkeypatch.delenv(env.BACKEND.name, raising=False)
     monkeypatch.setenv(name, value)
     out = tmp_path / "x.png"
     for prog, run, argv in (("wgpuviewer", cli.main, ["render", "-o", str(out), "--size", "16x16",

@@ -36,12 +36,20 @@ def huge_jpeg(path, w=HUGE, h=HUGE):
     return path
 
 
-def huge_exr(path, w=HUGE, h=HUGE):
+EXR_UINT, EXR_HALF, EXR_FLOAT = 0, 1, 2
+
+
+def huge_exr(path, w=HUGE, h=HUGE, channels=(("Y", EXR_FLOAT, 1),), flags=0, kind=b""):
+    """An EXR header and no pixel data: ``channels`` as (name, pixel type, sampling), ``flags`` in the version
+    field, ``kind`` the ``type`` attribute (empty: none)."""
     def attribute(name: bytes, kind: bytes, value: bytes) -> bytes:
         return name + b"\0" + kind + b"\0" + struct.pack("<i", len(value)) + value
 
-    path.write_bytes(b"\x76\x2f\x31\x01" + struct.pack("<i", 2)
-                     + attribute(b"channels", b"chlist", b"Y\0" + b"\0" * 16 + b"\0")
+    chlist = b"".join(name.encode() + b"\0" + struct.pack("<iB3xii", pixel_type, 0, sampling, sampling)
+                      for name, pixel_type, sampling in channels) + b"\0"
+    path.write_bytes(b"\x76\x2f\x31\x01" + struct.pack("<i", 2 | flags)
+                     + attribute(b"channels", b"chlist", chlist)
+                     + (attribute(b"type", b"string", kind) if kind else b"")
                      + attribute(b"dataWindow", b"box2i", struct.pack("<4i", 0, 0, w - 1, h - 1)) + b"\0" * 65)
     return path
 
@@ -132,10 +140,73 @@ def test_unsupported_contents_and_shapes(tmp_path):
     np.save(tmp_path / "obj.npy", np.array([[None]], dtype=object), allow_pickle=True)
     with pytest.raises(FileError, match="unsupported dtype object"):
         read_header(tmp_path / "obj.npy")
-    ok = huge_exr(tmp_path / "small.exr", 4, 4)
-    if not cv2.haveImageReader(str(ok)):  # builds without OpenEXR say so, with the fix
-        with pytest.raises(FileError, match="cannot read EXR; convert it"):
-            read_header(ok)
+
+
+def write_exr(path, channels: dict, tiled: bool = False):
+    """An EXR written by the openexr package (what a DCC tool or Poly Haven ships): ``channels`` name -> array."""
+    import OpenEXR
+
+    header = {"compression": OpenEXR.ZIP_COMPRESSION,
+              "type": OpenEXR.tiledimage if tiled else OpenEXR.scanlineimage}
+    if tiled:
+        header["tiles"] = OpenEXR.TileDescription()
+    with OpenEXR.File(header, channels) as exr:
+        exr.write(str(path))
+    return path
+
+
+def test_exr_heights_are_read_through_the_openexr_package(tmp_path):
+    rng = np.random.default_rng(1)
+    height = rng.random((12, 20)).astype(np.float32)
+    half = height.astype(np.float16)
+    cases = {
+        "y_float.exr": ({"Y": height}, height, False),
+        "z_half_tiled.exr": ({"Z": half}, half, True),  # any single channel name; tiles read like scan lines
+        "rgb_half.exr": ({"R": half, "G": half, "B": half}, half, False),  # equal colour channels: that channel
+        "ya.exr": ({"Y": height, "A": np.ones_like(height)}, height, False),
+    }
+    for name, (channels, expected, tiled) in cases.items():
+        path = write_exr(tmp_path / name, channels, tiled)
+        header = read_header(path)
+        assert (header.format, header.width, header.height) == ("exr", 20, 12), name
+        assert header.channel_names == tuple(channels), name
+        np.testing.assert_array_equal(read_height(path), expected.astype(np.float32), err_msg=name)
+    rgba = write_exr(tmp_path / "rgba.exr", {"R": half, "G": half * 0, "B": half * 0 + 1, "A": half})
+    image = read_image(rgba)  # R, G, B, A order (OpenCV's BGR does not apply)
+    assert image.shape == (12, 20, 4) and (image[..., 2] == 1).all() and (image[..., 1] == 0).all()
+    np.testing.assert_array_equal(read_height(rgba, "r"), half.astype(np.float32))
+
+
+@pytest.mark.parametrize("channels,flags,kind,reason", [
+    ((("Y", EXR_UINT, 1),), 0, b"", "EXR channel 'Y' holds UINT values; expected HALF or FLOAT"),
+    ((("Y", EXR_HALF, 2),), 0, b"", "EXR channel 'Y' is subsampled 2x2; expected full resolution"),
+    ((("R", EXR_HALF, 1), ("G", EXR_HALF, 1), ("B", EXR_HALF, 1), ("Z", EXR_FLOAT, 1)), 0, b"",
+     "EXR channels R, G, B, Z: expected one channel (the height), Y and A, or R, G, B (and A)"),
+    ((("Y", EXR_FLOAT, 1),), 0x800, b"", "deep EXR data"),
+    ((("Y", EXR_FLOAT, 1),), 0x1000, b"deepscanline", "deep EXR data"),
+])
+def test_an_exr_we_cannot_use_is_refused_from_its_header(tmp_path, channels, flags, kind, reason):
+    path = huge_exr(tmp_path / "h.exr", 8, 8, channels, flags, kind)  # no pixel data: nothing past the header
+    for read in (read_header, read_image, read_height):
+        with pytest.raises(FileError) as error:
+            read(path)
+        assert error.value.reason.startswith(reason), error.value.reason
+
+
+def test_a_damaged_exr_is_one_line_with_the_decoders_words(tmp_path, capfd):
+    """The openexr module prints its warning through Python's stdout and the library its own on stderr; both
+    belong in our one line, not on the terminal."""
+    good = write_exr(tmp_path / "good.exr", {"Y": np.linspace(0, 1, 64 * 64, dtype=np.float32).reshape(64, 64)})
+    data = good.read_bytes()
+    cut = tmp_path / "cut.exr"
+    cut.write_bytes(data[: len(data) // 2])
+    capfd.readouterr()
+    with pytest.raises(FileError) as error:
+        read_height(cut)
+    message = str(error.value)
+    assert message.startswith(f"{cut}: cannot decode image (corrupt or unsupported exr; the decoder said: ")
+    assert "\n" not in message
+    assert capfd.readouterr() == ("", "")
 
 
 def test_nan_policies_report_how_many_texels_they_replaced(tmp_path, caplog):

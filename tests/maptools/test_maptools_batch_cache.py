@@ -289,3 +289,107 @@ def test_cache_info_and_clean_refuse_a_cache_path_that_is_not_a_folder(tmp_path,
     assert len(err) == 1 and err[0].startswith(f"maptools: error: map cache {blocker}"), err
     assert "not a folder; set $WGPUVIEWER_CACHE_DIR to a folder" in err[0], err
     assert blocker.read_text() == "not a folder"
+
+
+# -- batch records and named maps ----------------------------------------------------------------------------------
+
+def test_batch_records_what_each_map_was_built_from(heights, tmp_path, capsys):
+    import hashlib
+    import json
+
+    from wgpuviewer.core.sidecar import read_record
+
+    out = tmp_path / "maps"
+    assert batch(heights / "h0.npy", "-o", out) == 0
+    record = read_record(out / "h0.normal.png")
+    assert (record.kind, record.channel, record.version) == ("normal", "auto", cache.VERSION)
+    assert record.options == cache.get_kind("normal").resolve({})
+    assert record.input_sha256 == hashlib.sha256((heights / "h0.npy").read_bytes()).hexdigest()
+    assert record.output_sha256 == hashlib.sha256((out / "h0.normal.png").read_bytes()).hexdigest()
+    # a record without the fields a scene checks (an older batch's) is not up to date: the map is made again
+    old = {k: v for k, v in json.loads((out / "h0.normal.png.json").read_text()).items()
+           if k not in ("channel", "output_sha256")}
+    (out / "h0.normal.png.json").write_text(json.dumps(old))
+    capsys.readouterr()
+    assert batch(heights / "h0.npy", "-o", out) == 0
+    assert "1 generated, 1 up to date, 0 failed" in capsys.readouterr().out
+    assert read_record(out / "h0.normal.png") == record
+
+
+def test_recording_says_where_each_map_came_from(cache_dir):
+    h = smooth_tileable(16, 16, 7)
+    with cache.recording() as outer:
+        cache.cached_generate("normal", h, backend="cpu")
+        with cache.recording() as inner:
+            cache.cached_generate("normal", h, backend="cpu")
+    assert inner == [cache.Served("normal", "cache")]
+    assert outer == [cache.Served("normal", "built"), cache.Served("normal", "cache")]
+
+
+@pytest.fixture
+def named(tmp_path, cache_dir):
+    """h.npy (16x16), its cone map (max_ratio 8) and complexity map (border repeat, 16-bit PNG) as maptools batch
+    writes them; (height, folder)."""
+    h = smooth_tileable(16, 16, 8)
+    np.save(tmp_path / "h.npy", h)
+    assert cli.main(["batch", str(tmp_path / "h.npy"), "-o", str(tmp_path / "maps"), "--kinds", "cone,complexity",
+                     "--set", "cone.max_ratio=8", "--set", "complexity.border=repeat", "--bits", "16",
+                     "--backend", "cpu"]) == 0
+    return h, tmp_path / "maps"
+
+
+def test_a_named_map_is_served_when_its_record_matches_the_request(named):
+    h, maps = named
+    files = {"cone": (maps / "h.cone.npy", "here"), "complexity": (maps / "h.complexity.png", "there")}
+    with cache.serving(files), cache.recording() as served:
+        cone = cache.cached_generate("cone", h, backend="cpu", max_ratio=8)
+        levels = cache.cached_generate("complexity", h, backend="cpu", border="repeat")
+        cache.cached_generate("normal", h, backend="cpu")  # a kind the scene does not name: built as ever
+    assert np.array_equal(cone, np.load(maps / "h.cone.npy"))
+    assert levels.dtype == np.uint8 and np.array_equal(levels, cache.generate("complexity", h, backend="cpu",
+                                                                              border="repeat"))
+    assert served == [cache.Served("cone", "file"), cache.Served("complexity", "file"),
+                      cache.Served("normal", "built")]
+    assert {e.kind for e in cache.entries()} == {"normal"}  # named maps are not copied into the cache
+
+
+@pytest.mark.parametrize("case,needle", [
+    ("options", "here: built with max_ratio=8.0, filter=bilinear; the renderer needs max_ratio=32.0, filter=nearest: "
+                "rebuild it (maptools batch {h} -o {maps} --kinds cone --set cone.max_ratio=32.0 "
+                "--set cone.filter=nearest)"),
+    ("one option", "here: built with filter=bilinear; the renderer needs filter=nearest: rebuild it (maptools batch "
+                   "{h} -o {maps} --kinds cone --set cone.max_ratio=8.0 --set cone.filter=nearest)"),  # 8 kept
+    ("version", "here: built by maptools-0, this is {version}: rebuild it (maptools batch {h} -o {maps} --kinds cone "
+                "--force)"),
+    ("bytes", "here: h.cone.npy changed after maptools batch wrote it (its sha256 is not its record's): rebuild it"),
+    ("kind", "here: is a complexity map (its record says so); expected a cone map"),
+    ("size", "here: a map of 16x16 texels; the height map is 8x4"),
+    ("record", "here: {maps}/h.cone.npy.json: not found; name a map written by maptools batch"),
+])
+def test_a_named_map_that_is_not_the_map_asked_for_is_refused(named, case, needle):
+    import dataclasses
+
+    from wgpuviewer.core.sidecar import read_record, write_record
+
+    h, maps = named
+    path = maps / "h.cone.npy"
+    options = {"max_ratio": 8}
+    if case == "options":
+        options = {"max_ratio": 32, "filter": "nearest"}
+    elif case == "one option":
+        options = {"max_ratio": 8, "filter": "nearest"}
+    elif case == "version":
+        write_record(path, dataclasses.replace(read_record(path), version="maptools-0"))
+    elif case == "bytes":
+        np.save(path, np.load(path) * 0.5)
+    elif case == "kind":
+        path = maps / "h.complexity.png"
+    elif case == "size":
+        h = h[:4, :8]
+    else:
+        (maps / "h.cone.npy.json").unlink()
+    with cache.serving({"cone": (path, "here")}), pytest.raises(cache.UserError) as error:
+        cache.cached_generate("cone", h, backend="cpu", **options)
+    expected = needle.format(h=maps.parent / "h.npy", maps=maps, version=cache.VERSION)
+    assert str(error.value) == expected if case in ("options", "one option", "version") else expected in str(error.value), \
+        str(error.value)

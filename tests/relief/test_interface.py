@@ -54,10 +54,11 @@ def test_data_out_is_generated_from_the_offscreen_targets():
     """fs_data's outputs and the offscreen formats are one list: location = position, each type fit for its
     format (WebGPU's sample type and channel rule, refused by name otherwise)."""
     assert renderer.OFFSCREEN_FORMATS == renderer.DATA_OUT.formats == (
-        renderer.COLOR_FORMAT, renderer.DATA_FORMAT, renderer.LAYERS_FORMAT, renderer.FILTER_FORMAT)
+        renderer.COLOR_FORMAT, renderer.DATA_FORMAT, renderer.LAYERS_FORMAT, renderer.FILTER_FORMAT,
+        renderer.VIEW_DEPTH_FORMAT)
     assert renderer.DATA_OUT.wgsl() == ("struct DataOut {\n    @location(0) color: vec4f,\n"
                                         "    @location(1) data: vec4u,\n    @location(2) layers: u32,\n"
-                                        "    @location(3) filtering: vec4u,\n}\n")
+                                        "    @location(3) filtering: vec4u,\n    @location(4) view_depth: u32,\n}\n")
     FragmentOutputs("Fine", [("a", "vec4f", "bgra8unorm-srgb"), ("b", "vec2i", "rg16sint"), ("c", "u32", "r8uint")])
     for target, words in [(("a", "vec2f", "rgba8unorm"), "needs f32 with at least 4 components"),
                           (("a", "vec4f", "rgba32uint"), "needs u32"),

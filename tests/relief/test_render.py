@@ -87,7 +87,7 @@ def test_modes_hold_raw_trace_data(default_renderer):
     image = default_renderer.render("pom", (128, 72))
     covered = image.covered
     assert 0.3 < covered.mean() < 1.0  # the plane and box cover part of the frame, the sky the rest
-    uv, depth, cost = (mode_data(image, m) for m in ("uv", "depth", "cost"))
+    uv, depth, cost = (mode_data(image, m) for m in ("uv", "layer_depth", "cost"))
     assert uv.shape == (72, 128, 2) and depth.shape == cost.shape == (72, 128)
     assert np.isnan(depth[~covered]).all() and np.isfinite(depth[covered]).all()
     assert ((depth[covered] >= 0) & (depth[covered] <= 1)).all()
@@ -96,7 +96,7 @@ def test_modes_hold_raw_trace_data(default_renderer):
     assert cost[covered].mean() > 2  # POM really marches
     basic = mode_data(default_renderer.render("basic", (128, 72)), "cost")
     assert np.nanmax(basic) == 0
-    for mode in ("color", "uv", "depth", "cost"):
+    for mode in ("color", "uv", "depth", "layer_depth", "cost"):
         picture = mode_picture(image, mode)
         assert picture.shape == (72, 128, 3) and picture.dtype == np.uint8
 

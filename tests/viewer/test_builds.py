@@ -132,3 +132,24 @@ def test_stopping_without_a_build_under_way_does_nothing():
     builds.cancel()
     builds.stop()
     assert builds.current is None and shown["A"] == "normal" and problems == []
+
+
+def test_the_build_line_counts_maps_and_estimates_the_time_left():
+    from wgpuviewer.viewer.builds import progress_line
+
+    assert progress_line("distance", "", 0, 0, 0.2) == "building distance: finishing, 0 s"  # nothing reported yet
+    assert progress_line("distance", "m.normal", 0, 4, 3.0) == "building distance: m.normal (map 1/4), 3 s"
+    assert progress_line("distance", "m.distance", 3, 4, 12.0) == (
+        "building distance: m.distance (map 4/4), 12 s, about 4 s left")  # 4 s a map so far, one to go
+    assert progress_line("distance", "done", 4, 4, 16.0) == "building distance: finishing, 16 s"
+
+
+def test_a_build_under_way_reports_its_step_on_the_line():
+    gate = threading.Event()
+    renderer = SteppedRenderer(built={"normal"}, gate=gate)
+    builds, _, _ = builds_for(renderer, background=True)
+    builds.request("A", "distance")
+    assert renderer.building.wait(10)
+    assert builds.current.line().startswith("building distance: m.normal (map 1/3), ")
+    gate.set()
+    assert builds.current.wait(10)

@@ -1,10 +1,11 @@
-"""Frame statistics: FPS current/min/avg/max, reset, GPU times."""
+"""Frame statistics: FPS current/min/avg/max, reset, GPU times; the heat maps' mean and p95 per half."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
-from wgpuviewer.viewer.stats import FrameStats
+from wgpuviewer.viewer.stats import FrameStats, Summary, half_summaries
 
 
 def feed(stats: FrameStats, dts, start=100.0) -> float:
@@ -45,3 +46,14 @@ def test_gpu_time_is_the_median_of_recent_frames():
         stats.add_gpu_time(ms)
     assert stats.gpu_time_ms == pytest.approx(1.15)
     assert "GPU 1.150 ms" in stats.lines()[1]
+
+
+def test_heat_map_summaries_give_mean_and_p95_of_the_drawn_pixels_of_each_half():
+    values = np.array([[0, 1, 2, 10], [-1, 3, -1, 20]], np.float32)  # -1: nothing drawn there
+    (whole,) = half_summaries(values, None)
+    assert whole.mean == pytest.approx(6.0) and whole.p95 == pytest.approx(np.percentile([0, 1, 2, 10, 3, 20], 95))
+    a, b = half_summaries(values, 0.5)  # A: columns 0-1, B: columns 2-3
+    assert a == Summary(pytest.approx(4 / 3), pytest.approx(2.8))  # 0, 1, 3: p95 between 1 and 3 at 0.9
+    assert b == Summary(pytest.approx(32 / 3), pytest.approx(19.0))  # 2, 10, 20
+    assert half_summaries(values, 0.25)[0] == Summary(0.0, 0.0)  # A is column 0: one drawn pixel
+    assert half_summaries(np.full((2, 4), -1, np.float32), 0.5) == [None, None]  # nothing drawn: no numbers

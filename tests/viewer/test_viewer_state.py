@@ -26,11 +26,28 @@ def test_the_state_needs_neither_wgpu_nor_a_toolkit():
     assert out.strip() == "[]"
 
 
-def test_start_shows_the_technique_on_a_and_the_next_one_on_b():
+def test_a_and_b_start_with_the_same_technique_filter_and_derivative_source():
     s = state(technique="pom")
-    assert s.halves == {"A": Half("pom", FIRST_FILTER, FIRST_SOURCE), "B": Half("basic", FIRST_FILTER, FIRST_SOURCE)}
+    assert s.halves == {"A": Half("pom", FIRST_FILTER, FIRST_SOURCE), "B": Half("pom", FIRST_FILTER, FIRST_SOURCE)}
     assert not s.split and s.side == "A" and [side for side, _ in s.shown()] == ["A"]
     assert state(technique="relief").techniques == ["basic", "normal", "pom", "relief"]  # not listed: added last
+
+
+def test_b_follows_a_while_unsplit_so_a_split_opens_on_the_same_picture():
+    s = state(technique="basic")
+    s.show("A", "normal")
+    s.cycle_filter()
+    s.toggle_split()  # two filters compared in three keys: B, Tab, F
+    assert s.halves["A"] == s.halves["B"] == Half("normal", SECOND_FILTER, FIRST_SOURCE)
+    s.switch_half()
+    s.cycle_filter()
+    assert s.halves["A"].filter == SECOND_FILTER and s.halves["B"].filter != SECOND_FILTER
+    s.show("A", "pom")  # split: B keeps its own
+    assert s.halves["B"].technique == "normal"
+    s.toggle_split()
+    assert s.halves["B"].technique == "normal"  # joined: B keeps what it showed until A changes
+    s.show("A", "basic")
+    assert s.halves["B"] == s.halves["A"] == Half("basic", SECOND_FILTER, FIRST_SOURCE)
 
 
 def test_number_keys_pick_by_the_registry_key_in_every_scene():
@@ -50,7 +67,8 @@ def test_arrows_step_through_the_scene_from_the_active_half():
     s = state(("basic", "normal", "pom"), "basic")
     assert s.next_technique(1) == "normal" and s.next_technique(-1) == "pom"
     s.toggle_split()
-    s.switch_half()  # B (normal) is active
+    s.switch_half()
+    s.show("B", "normal")  # B (normal) is active
     assert s.next_technique(1) == "pom"
 
 
@@ -96,3 +114,13 @@ def test_the_split_draws_two_scissored_passes_that_tile_the_frame():
     for split_x in (0.0, 1.0):  # the divider at an edge still leaves each half a column
         (_, (_, _, left, _)), (_, (x, _, right, _)) = scene_passes(["a", "b"], split_x, 100, 50)
         assert left >= 1 and right >= 1 and x == left and left + right == 100
+
+
+def test_every_key_action_is_a_viewer_method_taking_the_key_pressed():
+    import inspect
+
+    from wgpuviewer.viewer.app import Viewer
+    from wgpuviewer.viewer.keys import CONTROLS
+
+    actions = [c.action for c in CONTROLS if c.action]
+    assert actions and all(list(inspect.signature(getattr(Viewer, a)).parameters) == ["self", "key"] for a in actions)

@@ -40,13 +40,12 @@ def prepare_process(prog: str) -> None:
 
     - on POSIX, a private ``$XDG_RUNTIME_DIR`` when it is unset or invalid (Mesa prints four
       ``error: XDG_RUNTIME_DIR is invalid`` lines otherwise);
-    - OpenCV logs errors only (no ``[ WARN:0@...]`` lines; our readers report failures themselves) and reads EXR
-      where the build can;
-    - warnings of the project's loggers print as one line ``PROG: warning: ...`` on stderr.
+    - OpenCV logs errors only (no ``[ WARN:0@...]`` lines; our readers report failures themselves);
+    - notes (INFO: what a command chose or found) and warnings of the project's loggers print as one line each on
+      stderr, ``PROG: ...`` and ``PROG: warning: ...``.
     """
     prepare_driver_environment()
     os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
-    os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")
     cv2 = sys.modules.get("cv2")
     if cv2 is not None:  # already imported (in-process callers): the variable is read at import only
         cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)
@@ -55,13 +54,15 @@ def prepare_process(prog: str) -> None:
 
 class _WarningLine(logging.Handler):
     def __init__(self, prog: str):
-        super().__init__(level=logging.WARNING)
+        super().__init__(level=logging.INFO)
         self.prog = prog
 
     def emit(self, record):
         try:
-            kind = "warning" if record.levelno < logging.ERROR else "error"
-            print(f"{self.prog}: {kind}: {record.getMessage()}", file=sys.stderr)
+            # a note (INFO) says what the command chose or found; nothing to act on
+            kinds = {logging.INFO: "", logging.WARNING: "warning: "}
+            kind = kinds.get(record.levelno, "warning: " if record.levelno < logging.ERROR else "error: ")
+            print(f"{self.prog}: {kind}{record.getMessage()}", file=sys.stderr)
         except Exception:  # noqa: BLE001 - a broken stderr must not break the command
             self.handleError(record)
 
@@ -71,6 +72,7 @@ def _warnings_as_lines(prog: str) -> None:
         logger = logging.getLogger(name)
         logger.handlers = [h for h in logger.handlers if not isinstance(h, _WarningLine)]
         logger.addHandler(_WarningLine(prog))
+        logger.setLevel(logging.INFO)
 
 
 @contextlib.contextmanager
@@ -145,7 +147,8 @@ def add_backend_option(parser) -> None:
     from .gpu import BACKEND_CHOICES, BACKEND_ENV
 
     parser.add_argument("--backend", choices=BACKEND_CHOICES,
-                        help=f"wgpu backend (default: ${BACKEND_ENV} or auto: hardware first, then software)")
+                        help=f"wgpu backend (default: ${BACKEND_ENV}, else $WGPU_BACKEND_TYPE, else auto: hardware first, "
+                             "then software)")
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -1,6 +1,9 @@
 """The project's environment variables, each parsed in one place for every command and library call:
 
 - ``WGPUVIEWER_BACKEND``: the wgpu backend when no ``--backend`` is given (auto, vulkan, metal, dx12, gl);
+- ``WGPU_BACKEND_TYPE``: wgpu-py's variable for the same choice, in its names (Vulkan, Metal, D3D12, OpenGL,
+  OpenGLES, Undefined for auto), used when ``WGPUVIEWER_BACKEND`` is unset; when both are set ours wins, and a
+  one-line notice says so where they disagree (a bad ``WGPU_BACKEND_TYPE`` is then ignored, not refused);
 - ``WGPUVIEWER_CACHE_DIR``: the map cache folder (default ``~/.cache/wgpuviewer/maps``);
 - ``WGPUVIEWER_CACHE_MAX``: the map cache's size cap (500M, 2G, 1.5T, bytes; 0 turns the cap off; default 2G);
 - ``WGPUVIEWER_CONFIG_DIR``: the viewer's settings folder (default: the platform's config folder).
@@ -19,6 +22,7 @@ Standard library only: ``core.cli`` imports this before any GPU driver loads.
 
 from __future__ import annotations
 
+import logging
 import os
 import re
 import stat
@@ -29,6 +33,8 @@ from pathlib import Path
 from typing import Any
 
 from .errors import UserError
+
+log = logging.getLogger("wgpuviewer.env")
 
 _SIZE_UNITS = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
 
@@ -58,15 +64,23 @@ def _path(text: str) -> Path:
     return Path(text.strip()).expanduser()
 
 
+#: (variable, value, ignored variable, its value) already noted: the notice prints once per process.
+_NOTED: set[tuple[str, str, str, str]] = set()
+
+
 @dataclass(frozen=True)
 class Variable:
     """One environment variable: ``parse`` turns a set value into what it means (ValueError: what is expected);
-    ``default`` is used when it is unset or empty, ``default_text`` says what that is in errors."""
+    ``default`` is used when it is unset or empty, ``default_text`` says what that is in errors. ``fallback``:
+    another system's variable for the same setting, whose value is used instead of the default while this one is
+    unset; when both are set this one wins, with a one-line notice (a ``wgpuviewer.env`` warning, once) where
+    the two disagree."""
 
     name: str
     parse: Callable[[str], Any]
     default: Any
     default_text: str
+    fallback: Variable | None = None
 
     def raw(self) -> str | None:
         """The value as set, None when unset or empty."""
@@ -77,27 +91,64 @@ class Variable:
         """What the variable means now (read each call: tests and embedding programs change the environment)."""
         text = self.raw()
         if text is None:
-            return self.default
+            return self.default if self.fallback is None else self.fallback.value()
+        value = self._parsed(text)
+        if self.fallback is not None:
+            self._note_ignored_fallback(text, value)
+        return value
+
+    def _parsed(self, text: str):
         try:
             return self.parse(text)
         except ValueError as error:
             raise UserError(f"${self.name} = {text!r}: {error}; set a valid value or unset it "
                             f"(default: {self.default_text})") from None
 
+    def _note_ignored_fallback(self, text: str, value) -> None:
+        other = self.fallback.raw()
+        if other is None:
+            return
+        try:
+            same = self.fallback._parsed(other) == value
+        except UserError:  # ours wins: a value of theirs we could not use changes nothing
+            same = False
+        key = (self.name, text, self.fallback.name, other)
+        if not same and key not in _NOTED:
+            _NOTED.add(key)
+            log.warning(f"${self.name} = {text!r} wins over ${self.fallback.name} = {other!r}; unset one of them "
+                        "to silence this")
+
 
 #: wgpu backend names (``core.gpu.BACKEND_CHOICES`` is the same tuple, checked by a test).
 BACKEND_CHOICES = ("auto", "vulkan", "metal", "dx12", "gl")
 
-BACKEND = Variable("WGPUVIEWER_BACKEND", _choice(BACKEND_CHOICES), "auto", "auto")
+#: wgpu-py's backend names (``WGPU_BACKEND_TYPE``, its ``BackendType`` enum) of the backends we run on, as ours.
+WGPU_BACKEND_NAMES = {"Undefined": "auto", "Vulkan": "vulkan", "Metal": "metal", "D3D12": "dx12", "OpenGL": "gl",
+                      "OpenGLES": "gl"}
+
+
+def _wgpu_backend(text: str) -> str:
+    """A ``WGPU_BACKEND_TYPE`` value (any case) as one of BACKEND_CHOICES."""
+    for name, ours in WGPU_BACKEND_NAMES.items():
+        if text.strip().lower() == name.lower():
+            return ours
+    raise ValueError(f"expected one of {', '.join(WGPU_BACKEND_NAMES)} (wgpu-py's names of the backends "
+                     "wgpuviewer runs on)")
+
+
+WGPU_BACKEND = Variable("WGPU_BACKEND_TYPE", _wgpu_backend, "auto", "auto")
+BACKEND = Variable("WGPUVIEWER_BACKEND", _choice(BACKEND_CHOICES), "auto", f"${WGPU_BACKEND.name}, else auto",
+                   fallback=WGPU_BACKEND)
 CACHE_DIR = Variable("WGPUVIEWER_CACHE_DIR", _path, None, "~/.cache/wgpuviewer/maps")
 CACHE_MAX = Variable("WGPUVIEWER_CACHE_MAX", parse_bytes, 2 * 2**30, "2G")
 CONFIG_DIR = Variable("WGPUVIEWER_CONFIG_DIR", _path, None, "the platform's config folder")
 
+#: The project's variables (a fallback is read through the variable it stands in for).
 VARIABLES = (BACKEND, CACHE_DIR, CACHE_MAX, CONFIG_DIR)
 
 
 def check_environment() -> None:
-    """Parse every variable: the first bad one is a UserError."""
+    """Parse every variable (and the fallback of one that is unset): the first bad one is a UserError."""
     for variable in VARIABLES:
         variable.value()
 

@@ -4,8 +4,11 @@
 and whatever else Pillow identifies), with every limit checked there: a file declaring 60000x60000 is refused at
 once, before any data is read. Empty, truncated, missing and directory inputs are refused there too.
 
-``read_image``: an image file (8/16-bit PNG, JPEG, EXR where the OpenCV build reads it, TIFF, ... whatever OpenCV
-decodes) or a ``.npy`` array as float32 in [0, 1], RGB(A) order. ``read_height``: a height (or depth) map from
+``read_image``: an image file (8/16-bit PNG, JPEG, TIFF, ... whatever OpenCV decodes; OpenEXR through the
+``openexr`` package, which reads every compression and half/float channels, while the pip OpenCV wheels read no
+EXR) or a ``.npy`` array as float32 in [0, 1], RGB(A) order. An EXR's channels are one (any name: Y, Z, height),
+Y and A, or R, G, B (and A); its header says which before any pixel is read, and anything else (UINT or subsampled
+channels, deep data, other channel sets) is refused there. ``read_height``: a height (or depth) map from
 such a file as float32 (H, W) in [0, 1], with one channel rule everywhere:
 
 - ``auto``: a grey file as it is; a colour file whose colour channels are equal as that channel; any other colour
@@ -19,9 +22,10 @@ the nearest finite texel); how many were replaced is logged as a warning. Every 
 ``FileError`` (a ``UserError``) naming the file; its ``reason`` lets a caller name the key the file came from.
 A broken symbolic link or a link loop is named as such (``link_problem``), not as a missing or unreadable file.
 
-The native decoders (libpng, libjpeg) print their complaints on the process's stderr themselves; those lines are
-captured around each decode (``_native_stderr``) and end up in our one line: the reason of a decode that failed,
-or a warning naming the file when the decoder recovered (a damaged JPEG decodes with garbage in it).
+The native decoders (libpng, libjpeg, OpenEXR) print their complaints on the process's stderr themselves (the
+``openexr`` module also through Python's stdout); those lines are captured around each decode (``_native_stderr``,
+``_python_stdout``) and end up in our one line: the reason of a decode that failed, or a warning naming the file
+when the decoder recovered (a damaged JPEG decodes with garbage in it).
 """
 
 from __future__ import annotations
@@ -34,16 +38,13 @@ import struct
 import sys
 import tempfile
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
 import numpy as np
 
 from .errors import FileError, UserError
-
-# EXR where the OpenCV build has it (OpenCV reads the variable at its first EXR access).
-os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")
 
 HEIGHT_CHANNELS = ("auto", "grey", "r", "g", "b", "a", "luma")
 NAN_POLICIES = ("error", "zero", "nearest")
@@ -68,12 +69,14 @@ _REWRITE = "write or download it again"
 @dataclass(frozen=True)
 class Header:
     """What a file's first bytes say: ``format`` (npy, png, jpeg, exr or Pillow's name), ``width``, ``height``,
-    ``channels`` (0 where the header does not say)."""
+    ``channels`` (0 where the header does not say), ``channel_names`` (EXR: the channels in the order they are
+    read, e.g. R, G, B)."""
 
     format: str
     width: int
     height: int
     channels: int = 0
+    channel_names: tuple[str, ...] = ()
 
 
 def _npy_header(path: Path, f, size: int) -> Header:
@@ -97,26 +100,86 @@ def _npy_header(path: Path, f, size: int) -> Header:
     return header
 
 
+#: OpenEXR's version-field flags (the 4 bytes after the magic number): non-image (deep) data.
+_EXR_DEEP = 0x800
+#: OpenEXR pixel types in a channel list.
+_EXR_PIXEL_TYPES = {0: "UINT", 1: "HALF", 2: "FLOAT"}
+
+
+@dataclass(frozen=True)
+class _ExrChannel:
+    name: str
+    pixel_type: int
+    sampling: tuple[int, int]
+
+
+def _exr_channels(value: bytes) -> list[_ExrChannel]:
+    """An EXR ``chlist`` attribute: per channel its name, NUL, pixel type (int32), pLinear and 3 reserved bytes,
+    x and y sampling (int32); a NUL ends the list."""
+    channels, at = [], 0
+    while at < len(value) and value[at]:
+        end = value.index(b"\0", at)
+        pixel_type, _linear, x, y = struct.unpack_from("<iB3xii", value, end + 1)
+        channels.append(_ExrChannel(value[at:end].decode(errors="replace"), pixel_type, (x, y)))
+        at = end + 17
+    return channels
+
+
+def _exr_order(path: Path, channels: list[_ExrChannel]) -> list[str]:
+    """The channels of an EXR in the order they are read: one channel (grey, any name), Y and A (grey + alpha),
+    or R, G, B (and A); each HALF or FLOAT at full resolution."""
+    names = [c.name for c in channels]
+    shown = ", ".join(names) or "none"
+    for c in channels:
+        if c.pixel_type not in (1, 2):
+            kind = _EXR_PIXEL_TYPES.get(c.pixel_type, f"type {c.pixel_type}")
+            raise FileError(path, f"EXR channel {c.name!r} holds {kind} values; expected HALF or FLOAT (save the "
+                                  "height as a float channel)")
+        if c.sampling != (1, 1):
+            raise FileError(path, f"EXR channel {c.name!r} is subsampled {c.sampling[0]}x{c.sampling[1]}; expected "
+                                  "full resolution")
+    by_upper = {n.upper(): n for n in names}
+    for order in (["R", "G", "B", "A"], ["R", "G", "B"], ["Y", "A"]):
+        if len(names) == len(order) and set(by_upper) == set(order):
+            return [by_upper[n] for n in order]
+    if len(names) == 1:
+        return names
+    raise FileError(path, f"EXR channels {shown}: expected one channel (the height), Y and A, or R, G, B (and A); "
+                          "save the height as its own file")
+
+
 def _exr_header(path: Path, f) -> Header:
-    """OpenEXR: attributes name, type, size, value after magic and version; ``dataWindow`` (box2i) is the size."""
-    f.seek(8)
-    window, channels = None, 0
+    """OpenEXR: after magic and version, attributes (name, type, size, value); ``dataWindow`` (box2i) is the size,
+    ``channels`` (chlist) what is stored (``_exr_order``: the channel names in the order they are read). A
+    multi-part file's first header is its first part's, which is the part read."""
+    (version,) = struct.unpack("<i", f.read(8)[4:].ljust(4, b"\0"))
+    window, channels, deep = None, None, bool(version & _EXR_DEEP)
     for _ in range(1024):
         name = _cstring(f)
         if not name:
             break
-        kind, (length,) = _cstring(f), struct.unpack("<i", f.read(4) or b"\0\0\0\0")
+        kind, (length,) = _cstring(f), struct.unpack("<i", f.read(4).ljust(4, b"\0"))
         value = f.read(max(length, 0))
         if len(value) < length:
             break
         if name == b"dataWindow" and kind == b"box2i" and length == 16:
             window = struct.unpack("<4i", value)
         elif name == b"channels" and kind == b"chlist":
-            channels = value.count(b"\0") // 2  # each channel: name NUL + 16 bytes; the list ends with a NUL
-    if window is None:
-        raise FileError(path, f"cannot read the EXR header (no dataWindow); {_REWRITE}")
+            try:
+                channels = _exr_channels(value)
+            except (ValueError, struct.error):
+                raise FileError(path, f"damaged EXR header (its channel list); {_REWRITE}") from None
+        elif name == b"type" and kind == b"string":
+            deep = deep or value.startswith(b"deep")
+    if window is None or channels is None:
+        missing = "dataWindow" if window is None else "channels"
+        raise FileError(path, f"cannot read the EXR header (no {missing}); {_REWRITE}")
     xmin, ymin, xmax, ymax = window
-    return Header("exr", xmax - xmin + 1, ymax - ymin + 1, channels)
+    header = Header("exr", xmax - xmin + 1, ymax - ymin + 1, len(channels))
+    _check_limits(path, header)
+    if deep:
+        raise FileError(path, "deep EXR data (several samples per pixel); save a flat scanline or tiled image")
+    return replace(header, channel_names=tuple(_exr_order(path, channels)))
 
 
 def _cstring(f) -> bytes:
@@ -205,11 +268,7 @@ def read_header(path) -> Header:
         if path.suffix.lower() == ".npy":
             raise FileError(path, "cannot read .npy array (no .npy header); save it with numpy.save")
         if magic.startswith(_EXR_MAGIC):
-            header = _exr_header(path, f)
-            _check_limits(path, header)
-            if not cv2.haveImageReader(str(path)):
-                raise FileError(path, "this OpenCV build cannot read EXR; convert it to a 16-bit PNG or .npy")
-            return header
+            return _exr_header(path, f)
         known = "png" if magic.startswith(_PNG_MAGIC) else "jpeg" if magic.startswith(_JPEG_MAGIC) else ""
         try:
             header = _pil_header(path)
@@ -292,8 +351,55 @@ def _native_stderr(messages: list[str]):
                     messages.append(line.strip())
 
 
+class _CapturedStdout:
+    """Stands in for ``sys.stdout`` while the ``openexr`` module decodes: what the decoding thread prints (the
+    module's warnings) is kept; other threads write to the stream that was there."""
+
+    def __init__(self, stream):
+        self._stream, self._owner, self.text = stream, threading.get_ident(), []
+
+    def write(self, text):
+        if threading.get_ident() != self._owner:
+            return self._stream.write(text)
+        self.text.append(text)
+        return len(text)
+
+    def __getattr__(self, name):  # flush, fileno, isatty, encoding, ...
+        return getattr(self._stream, name)
+
+
+@contextlib.contextmanager
+def _python_stdout(messages: list[str]):
+    """Appends to ``messages`` the lines this thread prints through Python's stdout during the block."""
+    captured = _CapturedStdout(sys.stdout)
+    sys.stdout = captured
+    try:
+        yield
+    finally:
+        if sys.stdout is captured:
+            sys.stdout = captured._stream
+        messages.extend(line.strip() for line in "".join(captured.text).splitlines() if line.strip())
+
+
+def _decode_exr(path: Path, header: Header, said: list[str]) -> np.ndarray | None:
+    """The channels ``header`` names (R, G, B order), stacked; None when the file cannot be decoded (why: in
+    ``said``, with the decoder's own lines)."""
+    import OpenEXR
+
+    try:
+        with OpenEXR.File(str(path), separate_channels=True) as exr:
+            planes = exr.channels() if exr.parts else {}
+            data = [planes[name].pixels for name in header.channel_names if name in planes]
+    except Exception as e:  # noqa: BLE001 - the library's exceptions for a bad file have no common type
+        said.append(f"{type(e).__name__}: {e}")
+        return None
+    if len(data) != len(header.channel_names) or any(d is None for d in data):
+        return None
+    return data[0] if len(data) == 1 else np.stack(data, axis=-1)
+
+
 def _decode(path: Path) -> tuple[np.ndarray, bool]:
-    """Raw array of a file and whether its channels are in RGB(A) order (.npy) rather than BGR(A) (OpenCV).
+    """Raw array of a file and whether its channels are in RGB(A) order (.npy, EXR) rather than BGR(A) (OpenCV).
     The header is checked first: nothing over the limits is ever loaded."""
     header = read_header(path)
     if header.format == "npy":
@@ -302,11 +408,15 @@ def _decode(path: Path) -> tuple[np.ndarray, bool]:
         except Exception as e:  # noqa: BLE001 - any parse failure is the file's fault
             raise FileError(path, f"cannot read .npy array ({type(e).__name__}: {e}); save it with numpy.save") \
                 from None
-    encoded = np.fromfile(path, np.uint8)
     said: list[str] = []
-    with _native_stderr(said):
-        # imdecode instead of imread: the same decoders, but non-ASCII paths work everywhere.
-        data = cv2.imdecode(encoded, cv2.IMREAD_UNCHANGED)
+    if header.format == "exr":
+        with _native_stderr(said), _python_stdout(said):
+            data = _decode_exr(path, header, said)
+    else:
+        encoded = np.fromfile(path, np.uint8)
+        with _native_stderr(said):
+            # imdecode instead of imread: the same decoders, but non-ASCII paths work everywhere.
+            data = cv2.imdecode(encoded, cv2.IMREAD_UNCHANGED)
     decoder = f"; the decoder said: {'; '.join(said)}" if said else ""
     if data is None:
         raise FileError(path, f"cannot decode image (corrupt or unsupported {header.format}{decoder}); "
@@ -314,7 +424,7 @@ def _decode(path: Path) -> tuple[np.ndarray, bool]:
     if said:
         log.warning(f"{path}: decoded, but the {header.format} decoder said: {'; '.join(said)}; if the image looks "
                     "damaged, write or download it again")
-    return data, False
+    return data, header.format == "exr"
 
 
 def _scaled(data: np.ndarray, path: Path) -> np.ndarray:

@@ -78,6 +78,6 @@ def run_study(study: Study, args: argparse.Namespace) -> int:
 def add_measurement_options(parser, out_help: str, suite_help: str) -> None:
     """The options every measuring command has: --out, --suite smoke|full (default full), --backend, --quiet."""
     parser.add_argument("--out", required=True, help=out_help)
-    parser.add_argument("--suite", choices=NAMES, default="full", help=suite_help)
+    parser.add_argument("--suite", choices=NAMES, default="full", help=f"{suite_help} (default %(default)s)")
     add_backend_option(parser)
     parser.add_argument("--quiet", action="store_true", help="no progress bar")

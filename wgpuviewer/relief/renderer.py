@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import wgpu
 
-from maptools.cache import cached_generate
+from maptools.cache import cached_generate, serving
 from wgpuviewer import camera as cam
 from wgpuviewer import meshes, textures
 from wgpuviewer.core.errors import UserError
@@ -48,6 +48,7 @@ COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs
 DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, depth, fetches
 LAYERS_FORMAT = "r32uint"  # offscreen: depth layers the search used per pixel
 FILTER_FORMAT = "rgba32uint"  # offscreen: the filter's texels, depth fetches, hidden | flags << 24, ratio bits
+VIEW_DEPTH_FORMAT = "r32uint"  # offscreen: camera depth of the traced hit (float bits)
 DEPTH_FORMAT = "depth32float"
 #: The targets of an offscreen render, in order: fs_data's outputs (generated into the render module) and their
 #: formats. Raw values travel as float bits in 32-bit integer targets: float32 targets are not renderable
@@ -57,6 +58,7 @@ DATA_OUT = FragmentOutputs("DataOut", [
     ("data", "vec4u", DATA_FORMAT),  # fetches negative: capped
     ("layers", "u32", LAYERS_FORMAT),
     ("filtering", "vec4u", FILTER_FORMAT),
+    ("view_depth", "u32", VIEW_DEPTH_FORMAT),
 ])
 OFFSCREEN_FORMATS = DATA_OUT.formats
 
@@ -65,8 +67,8 @@ _PIXEL_BYTES = {"rgba8unorm-srgb": 4, "rgba32uint": 16, "r32uint": 4, "depth32fl
 #: What a user can do about a frame too large for the adapter.
 SMALLER_FRAME = "use a smaller size"
 
-#: Frame.mode values (render.wgsl).
-MODES = {"color": 0, "cost": 1, "uv": 2, "depth": 3, "layers": 4, "albedo": 5}
+#: Frame.mode values (render.wgsl's MODE_* constants; "depth" draws its own entry point, fs_view_depth).
+MODES = {"color": 0, "cost": 1, "uv": 2, "layer_depth": 3, "layers": 4, "albedo": 5, "depth": 6}
 
 #: Draw configurations whose uniform buffer and bind group are kept per material (the least recently drawn are
 #: dropped): draws with different parameters can share one submit (the A/B split, the benchmark's batched frames).
@@ -124,6 +126,9 @@ class OffscreenImage:
     #: (H, W, 4) uint32: texels the filter read, depth fetches of its visibility traces and slopes,
     #: hidden texels | flags << 24 (filters.FLAGS), the derivative source's raw length ratio as float32 bits.
     filter: np.ndarray | None = None
+    #: (H, W) float32: camera depth of the traced hit, the distance from the camera along its view axis in scene
+    #: units (linear view-space depth, not the depth buffer's reversed-Z value).
+    view_depth: np.ndarray | None = None
 
     @property
     def covered(self) -> np.ndarray:
@@ -183,9 +188,9 @@ class Renderer:
         model = cam.translation(obj.position) @ cam.rotation_xyz(obj.rotation)
         normal_matrix = np.eye(4)
         normal_matrix[:3, :3] = np.linalg.inv(model[:3, :3]).T
-        uv_scale = self.scene.materials[obj.material].uv_scale
+        material = self.scene.materials[obj.material]
         data = OBJECT.pack({"model": cam.to_wgsl(model), "normal_matrix": cam.to_wgsl(normal_matrix),
-                            "uv_scale": [*uv_scale, 0, 0]})
+                            "uv_transform": [*material.uv_scale, *offset_fraction(material.uv_offset)]})
         ubuf = device.create_buffer_with_data(label=f"object:{index}", data=data, usage=wgpu.BufferUsage.UNIFORM)
         group = device.create_bind_group(layout=self._object_layout, entries=[{"binding": 0, "resource": {"buffer": ubuf}}])
         return obj.material, vbuf, len(vertices), group
@@ -235,7 +240,7 @@ class Renderer:
                 if material_name not in self._depth_ranges:  # while the depth is loaded anyway
                     self._depth_ranges[material_name] = depth_range(depth, self.gpu.depth_format)
                 measured = (probe,) if slot.measured else ()  # auto's table: measured with the probe
-                with _reported_against(material.height, kind):
+                with _building(material, kind):
                     self._textures[key] = slot.build(self.gpu, depth, material.height_scale, label, *measured)
             else:
                 if kind == "normal":
@@ -348,13 +353,16 @@ class Renderer:
         return compose_technique(technique, "render", filter, derivatives, records=(DATA_OUT.generated(),))
 
     def pipeline(self, technique: Technique, formats: tuple[str, ...], filter: str = DEFAULT_FILTER,
-                 derivatives: str = DEFAULT_DERIVATIVES) -> wgpu.GPURenderPipeline:
-        key = (technique.name, filter, derivatives, formats)
+                 derivatives: str = DEFAULT_DERIVATIVES, mode: str = "color") -> wgpu.GPURenderPipeline:
+        """The render pipeline of a technique with a filter and derivative source into ``formats``: one target
+        draws ``fs_color`` (``fs_view_depth`` for ``mode`` "depth"), more draw ``fs_data`` (OFFSCREEN_FORMATS)."""
+        entry = fragment_entry(formats, mode)
+        key = (technique.name, filter, derivatives, formats, entry)
         if key not in self._pipelines:
             device = self.gpu.device
             what = technique.name if (filter, derivatives) == (DEFAULT_FILTER, DEFAULT_DERIVATIVES) \
                 else f"{technique.name}/{filter}/{derivatives}"
-            label = f"render:{what}:{'+'.join(formats)}"
+            label = f"render:{what}:{entry}:{'+'.join(formats)}"
             code = self.module(technique, filter, derivatives).code
             module = device.create_shader_module(label=label, code=code)
             layout = device.create_pipeline_layout(
@@ -375,11 +383,11 @@ class Renderer:
                 depth_stencil={"format": DEPTH_FORMAT, "depth_write_enabled": True, "depth_compare": "greater"},
                 fragment={
                     "module": module,
-                    "entry_point": "fs_color" if len(formats) == 1 else "fs_data",
+                    "entry_point": entry,
                     "targets": [{"format": f} for f in formats],
                 },
             )
-            self.created.append(f"pipeline:{what}:{'+'.join(formats)}")
+            self.created.append(f"pipeline:{what}:{'+'.join(formats)}" + ("" if entry != "fs_view_depth" else ":depth"))
         return self._pipelines[key]
 
     # --- frames ------------------------------------------------------------------------------
@@ -390,11 +398,11 @@ class Renderer:
         file (``file:line:column: reason``, core.wgsl.Module.locate)."""
         failures = []
         for key in list(self._pipelines):
-            name, filter, derivatives, formats = key
+            name, filter, derivatives, formats, entry = key
             technique = get_technique(name)
             old = self._pipelines.pop(key)
             try:
-                self.pipeline(technique, formats, filter, derivatives)
+                self.pipeline(technique, formats, filter, derivatives, "depth" if entry == "fs_view_depth" else "color")
             except wgpu.GPUError as error:
                 self._pipelines[key] = old
                 try:
@@ -442,8 +450,8 @@ class Renderer:
         scissor: tuple[int, int, int, int] | None = None,
         timestamp_writes: dict | None = None,
     ) -> None:
-        """Record one frame of ``draw`` into ``color_views`` (1 target: fs_color; 4: fs_data, formats
-        OFFSCREEN_FORMATS).
+        """Record one frame of ``draw`` into ``color_views`` (1 target: fs_color, which shows ``mode``; more: fs_data,
+        the first of OFFSCREEN_FORMATS).
 
         ``clear=False`` keeps what the targets hold and ``scissor`` (x, y, w, h) limits the drawing:
         together they put several techniques side by side in one frame. ``timestamp_writes`` goes to
@@ -452,7 +460,7 @@ class Renderer:
         technique = get_technique(draw.technique)
         params = draw.values
         self._write_frame(camera, size, mode, technique, params)
-        pipeline = self.pipeline(technique, formats, draw.filter, draw.derivatives)
+        pipeline = self.pipeline(technique, formats, draw.filter, draw.derivatives, mode)
         filter_group = self._filter_group(draw)
         groups = {}
         for material_name in {m for m, *_ in self._objects}:
@@ -495,7 +503,8 @@ class Renderer:
 
     def render(self, draw: DrawConfig | str, size: tuple[int, int], camera: Camera | None = None,
                mode: str = "color", *, size_name: str = "render size") -> OffscreenImage:
-        """Draw offscreen and read back the colour, the raw trace data and the filter's statistics. ``draw``: a
+        """Draw offscreen and read back the colour, the raw trace data, the camera depth and the filter's
+        statistics (every output mode is made from them: ``relief.output``). ``draw``: a
         DrawConfig, or a technique name (drawn with the scene's parameters for it). ``mode`` "albedo" makes the
         colour the filtered albedo, unlit; every other mode reads the shaded colour. A frame too large for the
         adapter (``check_frame_size``, or its memory) is a UserError naming ``size_name`` (the CLI: ``--size``)."""
@@ -513,11 +522,14 @@ class Renderer:
                                            usage=usage)
             stats = device.create_texture(label="offscreen:filter", size=(w, h, 1), format=FILTER_FORMAT,
                                           usage=usage)
+            view_depth = device.create_texture(label="offscreen:view_depth", size=(w, h, 1),
+                                               format=VIEW_DEPTH_FORMAT, usage=usage)
             depth = device.create_texture(label="offscreen:depth", size=(w, h, 1), format=DEPTH_FORMAT,
                                           usage=wgpu.TextureUsage.RENDER_ATTACHMENT)
         encoder = device.create_command_encoder(label="offscreen")
         self.encode(
-            encoder, [color.create_view(), data.create_view(), layers.create_view(), stats.create_view()],
+            encoder, [color.create_view(), data.create_view(), layers.create_view(), stats.create_view(),
+                      view_depth.create_view()],
             depth.create_view(), OFFSCREEN_FORMATS, draw,
             camera or self.scene.camera, size, "albedo" if mode == "albedo" else "color",
         )
@@ -529,6 +541,7 @@ class Renderer:
                 layers=_read_texture(device, layers, 1, np.uint32)[:, :, 0],
                 layer_range=get_technique(draw.technique).layer_range(draw.values),
                 filter=_read_texture(device, stats, 4, np.uint32),
+                view_depth=_read_texture(device, view_depth, 1, np.uint32)[:, :, 0].view(np.float32),
             )
 
 
@@ -583,6 +596,16 @@ def _height_size(material) -> tuple[int, int]:
 
 
 @contextlib.contextmanager
+def _building(material, kind: str):
+    """Around the build of a material's derived map ``kind``: the maps the scene names for the material
+    (``Material.maps``) are served from their files (``maptools.cache.serving``), and problems are reported against
+    the height map's key, except a named map's, whose messages name its own key."""
+    named = {slot: (ref.path, ref.origin) for slot, ref in material.maps}
+    with _reported_against(None if kind in named else material.height, kind), serving(named):
+        yield
+
+
+@contextlib.contextmanager
 def _reported_against(ref, kind: str):
     """A texture of slot ``kind`` that cannot be built (too large for a limit or for the adapter's memory, ...) is
     reported against the scene key of the texture it comes from (``ref``; the height map for a derived map), not
@@ -593,6 +616,21 @@ def _reported_against(ref, kind: str):
         if ref is None or not ref.origin:
             raise
         raise ref.error(f"its {kind} map cannot be built: {error}") from None
+
+
+def fragment_entry(formats: tuple[str, ...], mode: str) -> str:
+    """The fragment entry point of render.wgsl that draws into ``formats`` in ``mode``."""
+    if len(formats) > 1:
+        return "fs_data"
+    return "fs_view_depth" if mode == "depth" else "fs_color"
+
+
+def offset_fraction(uv_offset: tuple[float, float]) -> tuple[float, float]:
+    """``Material.uv_offset`` less its whole tiles, in float64 (``x - floor(x)``: exact for x >= 0, within 2^-53
+    below), in [0, 1]. The materials repeat, so whole tiles move nothing; what reaches the GPU's float32 is the
+    fraction alone, and an offset of 1e5 tiles draws exactly what its fraction draws."""
+    offset = np.asarray(uv_offset, np.float64)
+    return tuple(float(x) for x in offset - np.floor(offset))
 
 
 def scene_lights(scene) -> np.ndarray:

@@ -39,7 +39,9 @@ FRAME = Struct("Frame", [
 OBJECT = Struct("Object", [
     ("model", "mat4x4f"),
     ("normal_matrix", "mat4x4f"),
-    ("uv_scale", "vec4f"),  # xy: texture repeats across the face
+    # xy: Material.uv_scale (texture repeats across the face); zw: the fraction of Material.uv_offset, its whole
+    # tiles dropped in float64 (repeat addressing: the same texture), so the uv the GPU interpolates stays small
+    ("uv_transform", "vec4f"),
 ])
 
 

@@ -1,9 +1,10 @@
 """The interactive viewer on any wgpu backend, in a rendercanvas window (``window``: glfw by default, Qt on request).
 
 Compare relief-mapping techniques live: number keys and Left/Right switch techniques, F the texture filter
-(Shift+F its derivative source), B splits the screen between two techniques or filters (drag the divider),
+(Shift+F its derivative source), B splits the screen between two techniques or filters (both halves start alike,
+Tab picks the half the keys change; drag the divider),
 Shift+D shows the cost (depth fetches per pixel) and Shift+E the UV error against a high-layer-count POM
-reference, both as heat maps with a legend.
+reference, both as heat maps with a legend that gives each half's mean and 95th percentile.
 A HUD (imgui) shows FPS/frame/GPU time, the technique's description and live parameters, and the
 keys (F1). Edited WGSL files are recompiled on the fly. Settings persist between sessions
 (``settings``). ``keys.CONTROLS`` lists every key.
@@ -45,7 +46,7 @@ from .input import Input
 from .keys import PRESSED, TECHNIQUE_KEYS
 from .settings import LIMITS, Settings, save_session
 from .state import Half, ViewerState
-from .stats import FrameStats, GpuTimer
+from .stats import FrameStats, GpuTimer, Summary, half_summaries, split_column
 from .window import Window, toolkit
 
 MODES = ("color", "cost", "error")
@@ -108,6 +109,10 @@ class Viewer:
         self.reloader = ShaderReloader(self.renderer)
         self._shown_errors: list[str] = []
         self.frames = FrameEncoder(self.renderer, self.window.format, self.timer)
+        #: The cost or error view's mean and p95 per half shown (the legend's numbers); what they were measured on.
+        self.heat_summaries: list[Summary | None] = []
+        self._summarised_errors = None  # the error map summarised
+        self._cost_key, self._cost_time = None, -1e9  # what the fetches were measured on, and when
         self._want_screenshot = False
         from . import hud as hud_module
 
@@ -148,6 +153,7 @@ class Viewer:
                 return
         self.mode = mode
         self.frames.invalidate_error_view()
+        self.heat_summaries, self._summarised_errors, self._cost_key = [], None, None
         self._update_title()
 
     def toggle_mode(self, mode: str):
@@ -222,9 +228,6 @@ class Viewer:
         self.message(f"screenshot: {path}")
         return path
 
-    def reset_stats(self):
-        self.stats.reset()
-
     def technique_params(self, name: str) -> dict:
         """The live parameters of technique ``name`` (the dict the HUD edits)."""
         return self.params.setdefault(name, get_technique(name).defaults())
@@ -236,8 +239,9 @@ class Viewer:
         return DrawConfig.of(name, self.technique_params(name), self.height_scales.get(name), filter=half.filter,
                              filter_params=self.filter_params[half.filter], derivatives=half.derivatives)
 
-    def cost_scale(self) -> float:
-        name = self.state.halves["A"].technique
+    def cost_scale(self, side: str = "A") -> float:
+        """The fetch count the cost view paints as full heat on half ``side``."""
+        name = self.state.halves[side].technique
         return get_technique(name).cost_scale(self.technique_params(name))
 
     def material_height_scales(self) -> str:
@@ -281,6 +285,9 @@ class Viewer:
     def cycle_technique(self, key: str):
         self.set_technique(self.state.next_technique(1 if key == "ArrowRight" else -1))
 
+    def reset_stats(self, key: str):
+        self.stats.reset()
+
     def reset_camera(self, key: str):
         self.cam.reset()
 
@@ -294,13 +301,7 @@ class Viewer:
         self.set_mode(MODES[(MODES.index(self.mode) + 1) % len(MODES)])
 
     def toggle_split(self, key: str):
-        state = self.state
-        state.toggle_split()
-        b = state.halves["B"]
-        if state.split and not self.builds.ready(b.technique):  # B draws A's technique until its maps are built
-            wanted = b.technique
-            state.show("B", state.halves["A"].technique)
-            self.set_technique(wanted, "B")
+        self.state.toggle_split()  # B shows only techniques that were shown (built) before: nothing to build here
 
     def switch_half(self, key: str):
         self.state.switch_half()
@@ -369,6 +370,8 @@ class Viewer:
         split_x = state.split_x if state.split else None
         if self.mode == "error":
             self.frames.update_error_view(draws, split_x, (w, h), camera, now)
+        if self.mode in ("cost", "error"):
+            self._update_heat_summaries(draws, split_x, (w, h), camera, now)
         screenshot = None
         if self._want_screenshot:
             self._want_screenshot = False
@@ -376,6 +379,28 @@ class Viewer:
         self.frames.encode(texture, draws, split_x, camera, self.mode, error_range=self.error_range,
                            screenshot=screenshot, hud=self.hud)
         return texture
+
+    def _update_heat_summaries(self, draws: list[DrawConfig], split_x: float | None, size: tuple[int, int], camera,
+                               now: float) -> None:
+        """The legend's mean and p95 per half: of the error map the error view paints, or of the fetches of an
+        offscreen render at the error view's resolution (again when what it shows changed, at most ~3 times a
+        second)."""
+        from . import error_view
+
+        if self.mode == "error":
+            values = self.frames.error_values
+            if values is not None and values is not self._summarised_errors:
+                self.heat_summaries, self._summarised_errors = half_summaries(values, split_x), values
+            return
+        size = error_view.map_size(size)
+        key = (size, tuple(draws), split_x is not None and round(split_x, 3), camera)
+        if key == self._cost_key or (self._cost_key is not None and now - self._cost_time < 0.3):
+            return
+        values = error_view.cost_map(self.renderer, draws[0], size, camera)
+        if split_x is not None:
+            xs = split_column(split_x, size[0])
+            values[:, xs:] = error_view.cost_map(self.renderer, draws[1], size, camera)[:, xs:]
+        self.heat_summaries, self._cost_key, self._cost_time = half_summaries(values, split_x), key, now
 
     def read_frame(self, texture) -> np.ndarray:
         return self.frames.read(texture)

@@ -15,6 +15,18 @@ from wgpuviewer.core.cli import save_traceback
 from wgpuviewer.core.errors import InputError, UserError
 
 
+def progress_line(technique: str, label: str, done: int, total: int, elapsed: float) -> str:
+    """The HUD's build line: the map under way, the count of maps done, the time so far and, once a map is done, the
+    time left at the pace so far (maps differ in cost: an estimate), e.g.
+    ``building distance: bricks.distance (map 3/8), 12 s, about 20 s left``."""
+    if not total or done >= total:  # nothing reported yet, or every map built: the last step is under way
+        return f"building {technique}: finishing, {elapsed:.0f} s"
+    line = f"building {technique}: {label} (map {done + 1}/{total}), {elapsed:.0f} s"
+    if done:
+        line += f", about {elapsed / done * (total - done):.0f} s left"
+    return line
+
+
 class _Cancelled(Exception):
     """Raised in the worker at the next map once ``MapBuild.cancel`` was called."""
 
@@ -24,7 +36,7 @@ class MapBuild:
 
     def __init__(self, renderer, technique: str, side: str):
         self.technique, self.side = technique, side
-        self.label, self.done, self.total = "", 0, 0
+        self.step = ("", 0, 0)  # the last progress report: (label, maps done, maps in all), set in one assignment
         self.error: str | None = None
         self.started = time.perf_counter()
         self._cancel = threading.Event()
@@ -47,7 +59,7 @@ class MapBuild:
         # prepare reports each map before it builds it: the one place a build can stop between maps
         if self._cancel.is_set():
             raise _Cancelled
-        self.label, self.done, self.total = label, done, total
+        self.step = (label, done, total)
 
     def cancel(self) -> None:
         """Stop before the next map (the one being built is finished: a GPU dispatch cannot be interrupted)."""
@@ -62,10 +74,9 @@ class MapBuild:
         return self.finished
 
     def line(self) -> str:
-        """The HUD's progress line, e.g. ``building distance: bricks.distance (3/8), 12 s``."""
-        seconds = time.perf_counter() - self.started
-        step = f"{self.label} ({self.done + 1}/{self.total})" if self.total and self.done < self.total else "…"
-        return f"building {self.technique}: {step}, {seconds:.0f} s"
+        """The HUD's progress line (``progress_line``)."""
+        label, done, total = self.step
+        return progress_line(self.technique, label, done, total, time.perf_counter() - self.started)
 
 
 class Builds:
@@ -129,5 +140,5 @@ class Builds:
         build.cancel()
         if not build.wait(1.0):
             print(f"wgpuviewer: the window has closed; the {build.technique} build stops once "
-                  f"{build.label or 'its current map'} is built", file=sys.stderr)
+                  f"{build.step[0] or 'its current map'} is built", file=sys.stderr)
             build.wait()

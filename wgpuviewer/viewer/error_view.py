@@ -5,6 +5,8 @@ and the linear refinement its hit is, at viewer resolutions, indistinguishable f
 exact hit) are rendered offscreen at reduced resolution with the same camera; the wrap-aware texel
 distance of their hit UVs (``reference.uv_error_texels``) goes into an r32float texture that a
 small fullscreen pipeline (``wgsl/entry/error_view.wgsl``) paints over the frame with the cost view's heat colours.
+The overlay keeps the map it paints, and ``cost_map`` measures the cost view's fetches the same way, offscreen: the
+legends' mean and p95 per half come from them (``stats.half_summaries``).
 """
 
 from __future__ import annotations
@@ -57,6 +59,16 @@ def error_map(renderer: Renderer, draw: DrawConfig, size, camera, reference=None
     if covered.any():
         err[covered] = uv_error_texels(img.data[covered][:, :2], ref.data[covered][:, :2], texel_size(renderer))
     return err
+
+
+def cost_map(renderer: Renderer, draw: DrawConfig, size, camera) -> np.ndarray:
+    """(H, W) float32 depth fetches per pixel of ``draw``, what the cost view paints (a capped ray counts the fetches
+    it made); -1 where nothing was drawn."""
+    img = renderer.render(draw, size, camera)
+    covered = img.covered
+    fetches = np.full(covered.shape, -1.0, np.float32)
+    fetches[covered] = np.abs(img.data[..., 3][covered])
+    return fetches
 
 
 class ErrorOverlay:

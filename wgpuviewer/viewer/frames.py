@@ -31,6 +31,7 @@ class FrameEncoder:
         self._error_key = None
         self._error_time = -1e9
         self.error_texels = (1, 1)  # the error map's texel size (the legend's unit)
+        self.error_values = None  # the error map the overlay paints (the legend's per-half statistics)
 
     def invalidate_error_view(self) -> None:
         self._error_key = None
@@ -61,6 +62,7 @@ class FrameEncoder:
             values[:, xs:] = right[:, xs:]
         self.error_texels = error_view.texel_size(self.renderer)
         self._error.upload(values)
+        self.error_values = values
         self._error_key, self._error_time = key, now
 
     def encode(self, texture, draws: list[DrawConfig], split_x: float | None, camera: Camera, mode: str, *,

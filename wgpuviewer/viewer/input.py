@@ -1,6 +1,7 @@
 """The window's keyboard, pointer and wheel events as viewer actions: a key press goes to ``Viewer.press``
 (``keys.CONTROLS``), the fly keys are held and move the fly camera each frame, a left drag turns the camera or
-moves the A/B divider, the wheel zooms the orbit camera or changes the fly speed."""
+moves the A/B divider, the wheel zooms the orbit camera or changes the fly speed. A scripted run holds fly keys
+through ``hold``."""
 
 from __future__ import annotations
 
@@ -14,6 +15,8 @@ class Input:
     def __init__(self, viewer):
         self.viewer = viewer
         self.held: set[str] = set()
+        self.scripted: list[tuple[str, float]] = []  # (fly key, seconds) for the next frame
+        self.told_orbit = False
         self.drag_from: tuple[float, float] | None = None
         self.dragging_divider = False
         window = viewer.window
@@ -22,11 +25,22 @@ class Input:
         window.on(self.on_pointer, "pointer_down", "pointer_up", "pointer_move")
         window.on(self.on_wheel, "wheel")
 
+    def hold(self, key: str, seconds: float) -> None:
+        """A scripted run's fly key (``keys.ScriptStep``): held through the next frame, moving the camera by
+        ``seconds`` of motion whatever that frame takes."""
+        self.scripted.append((key, seconds))
+        if self.viewer.camera_mode != "fly" and not self.told_orbit:
+            self.told_orbit = True
+            self.viewer.message(f"--keys {key.upper()}: the fly keys move the fly camera; the orbit camera is on "
+                                "(O switches)")
+
     def fly(self, dt: float) -> None:
-        """Move the fly camera by the held keys for ``dt`` seconds."""
+        """Move the fly camera by the held keys for ``dt`` seconds, and by the scripted holds for theirs."""
         v = self.viewer
-        if self.held and v.camera_mode == "fly":
-            v.fly.move(*(np.sum([FLY_KEYS[k] for k in self.held], axis=0) * v.move_speed * dt))
+        moves = [(key, dt) for key in self.held] + self.scripted
+        self.scripted = []
+        if moves and v.camera_mode == "fly":
+            v.fly.move(*(np.sum([np.multiply(FLY_KEYS[k], s) for k, s in moves], axis=0) * v.move_speed))
 
     def on_key_down(self, event):
         key = event["key"]

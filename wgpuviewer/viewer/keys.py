@@ -4,12 +4,20 @@ help panel (F1) lists it, ``--keys`` checks against it, and the README's keys ta
 
 Key names are rendercanvas's event keys: Shift+D arrives as "D", so "d" (strafe, held) and "D" (cost view) are
 different keys. The number keys pick techniques by the registry's ``Technique.key`` (the same key in every scene).
+
+A scripted run's keys (``--keys``, ``parse_script``) are the pressed keys, one per frame, and the fly keys held for
+a time: ``W:0.5`` holds W (either case) for 0.5 seconds of camera motion, played at a fixed
+``SCRIPT_FRAME_SECONDS`` per frame whatever a frame really takes, so a script moves the camera the same on every
+machine: 15 frames of 1/30 s here, moving the fly camera 0.5 s x its move speed forward in all.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
+from wgpuviewer.core.errors import UserError
 from wgpuviewer.relief.techniques import TECHNIQUES, get_technique
 
 #: Number key -> the technique it picks (techniques whose key is "-" are reached with the arrows).
@@ -29,7 +37,9 @@ class Control:
 
 
 #: Held keys of the fly camera: direction (right, up, forward) each one moves in while held.
-FLY_KEYS = {"w": (0, 0, 1), "s": (0, 0, -1), "a": (-1, 0, 0), "d": (1, 0, 0), "e": (0, 1, 0), "q": (0, -1, 0)}
+FLY_KEYS = {"w": (0, 0, 1), "a": (-1, 0, 0), "s": (0, 0, -1), "d": (1, 0, 0), "q": (0, -1, 0), "e": (0, 1, 0)}
+#: How messages name them.
+FLY_LABEL = " ".join(FLY_KEYS).upper()
 
 CONTROLS = (
     Control("1–9, 0", "pick the technique (in A/B: of the active half); 0 is the tenth",
@@ -70,3 +80,48 @@ def markdown_table() -> str:
     rows = ["| key | action |", "|---|---|"]
     rows += [f"| {c.label} | {c.help} |" for c in CONTROLS]
     return "\n".join(rows)
+
+
+#: A scripted hold plays at this many seconds of camera motion per frame.
+SCRIPT_FRAME_SECONDS = 1 / 30
+#: The longest hold a script may give (1800 frames).
+MAX_HOLD_SECONDS = 60.0
+
+
+@dataclass(frozen=True)
+class ScriptStep:
+    """One frame of a scripted run: ``key`` pressed (``seconds`` 0), or the fly key ``key`` held for ``seconds``
+    of camera motion."""
+
+    key: str
+    seconds: float = 0.0
+
+
+def parse_script(items: Iterable[str]) -> list[ScriptStep]:
+    """The frames of ``--keys`` items (``2``, ``ArrowRight``, ``W:0.5``): a press is one frame, a hold of S seconds
+    ceil(S / SCRIPT_FRAME_SECONDS) frames sharing S evenly. A bad item is a UserError naming it and the fix."""
+    steps: list[ScriptStep] = []
+    for item in items:
+        key, colon, duration = item.partition(":")
+        fly = key.lower() if len(key) == 1 and key.lower() in FLY_KEYS else None
+        if not colon:
+            if key in PRESSED:
+                steps.append(ScriptStep(key))
+                continue
+            if fly:
+                raise UserError(f"--keys: {key!r} is a fly key, held for a time: give the seconds, e.g. {key}:0.5")
+            raise UserError(f"--keys: unknown key {key!r}; known: {', '.join(sorted(PRESSED))}, and the fly keys "
+                            f"{FLY_LABEL} held for seconds (W:0.5)")
+        if not fly:
+            raise UserError(f"--keys: {item!r}: only the fly keys {FLY_LABEL} are held for a time; "
+                            f"a pressed key is given alone (e.g. 2,W:0.5)")
+        try:
+            seconds = float(duration)
+        except ValueError:
+            seconds = math.nan
+        if not (math.isfinite(seconds) and 0 < seconds <= MAX_HOLD_SECONDS):
+            raise UserError(f"--keys: {item!r}: expected {key}:SECONDS with SECONDS in (0, {MAX_HOLD_SECONDS:g}], "
+                            f"e.g. {key}:0.5")
+        frames = max(1, math.ceil(seconds / SCRIPT_FRAME_SECONDS - 1e-9))
+        steps += [ScriptStep(fly, seconds / frames)] * frames
+    return steps

@@ -1,7 +1,8 @@
 """The viewer's run loop, interactive or scripted.
 
-Scripted runs (tests, demos): ``frames`` frames, ``keys`` pressed one per frame, the last frame (HUD included) saved
-to ``screenshot``; an ERROR logged while drawing makes the run exit 1, an error inside a frame ends it (exit 2 for a
+Scripted runs (tests, demos): ``frames`` frames, ``keys`` played one frame each (a pressed key; a fly key held for
+a time, ``W:0.5``, takes as many frames as ``keys.parse_script`` gives it), the last frame (HUD included) saved to
+``screenshot``; an ERROR logged while drawing makes the run exit 1, an error inside a frame ends it (exit 2 for a
 UserError). A key that closes the window (Escape) ends the script: no frame is drawn once the window is closing, even
 when the toolkit asks for one more, a run closed before its last frame says so (and writes no screenshot), and a map
 build under way stops before the run returns.
@@ -19,25 +20,24 @@ from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import refuse_directory
 from wgpuviewer.relief.output import save_rgb_png
 
-from .keys import PRESSED
+from .keys import parse_script
 
 #: The loggers whose ERRORs fail a scripted run.
 LOGGERS = ("wgpu", "rendercanvas")
 
 
 def scripted_frames(frames: int | None, screenshot: str | None, keys) -> int | None:
-    """How many frames a run draws (None: until the window is closed), after checking the script's arguments."""
+    """How many frames a run draws (None: until the window is closed), after checking the script's arguments
+    (``keys``: the ``--keys`` items). Needs no GPU and no display."""
     if frames is not None and frames < 1:
         raise UserError(f"--frames {frames}: expected a positive number of frames")
-    if (screenshot or keys) and frames is None:
-        frames = len(keys) + 3  # a screenshot or keys to press imply a scripted run, which ends by itself
+    steps = parse_script(keys)
+    if (screenshot or steps) and frames is None:
+        frames = len(steps) + 3  # a screenshot or keys to press imply a scripted run, which ends by itself
     if screenshot:
         refuse_directory(screenshot, "shot.png")
         if not screenshot.lower().endswith(".png"):
             raise UserError(f"--screenshot {screenshot}: expected a .png path")
-    unknown = [k for k in keys if k not in PRESSED]
-    if unknown:
-        raise UserError(f"--keys: unknown key {unknown[0]!r}; known: {', '.join(sorted(PRESSED))}")
     return frames
 
 
@@ -51,9 +51,10 @@ class _ErrorLogCounter(logging.Handler):
 
 
 def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=()) -> int:
-    """Draw ``viewer`` in its window until it closes (interactive: ``frames`` None) or for ``frames`` frames."""
+    """Draw ``viewer`` in its window until it closes (interactive: ``frames`` None) or for ``frames`` frames,
+    playing the ``--keys`` items ``keys``."""
     state = {"frame": 0}
-    pending = list(keys)
+    pending = parse_script(keys)
     window = viewer.window
     # rendercanvas only logs a failing draw and shows the previous frame: a scripted run must
     # notice, or a broken shader would pass as a green test.
@@ -64,7 +65,11 @@ def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=(
     def frame():
         try:
             if pending and not window.closed:
-                viewer.press(pending.pop(0))
+                step = pending.pop(0)
+                if step.seconds:
+                    viewer.input.hold(step.key, step.seconds)
+                else:
+                    viewer.press(step.key)
             if window.closed:  # Escape, or the toolkit asking once more: the surface is going, draw nothing
                 raise wgpu.DrawCancelled("the window is closing")
             texture = viewer.draw()

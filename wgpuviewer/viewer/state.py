@@ -7,7 +7,7 @@ built or a window (switching to a technique whose maps are missing, vsync, fulls
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS
 
@@ -39,12 +39,12 @@ class ViewerState:
 
     @classmethod
     def start(cls, techniques, technique: str, filter: str, derivatives: str) -> ViewerState:
-        """A shows ``technique``; B shows the scene's next one, both with the same filter and derivative source."""
+        """A and B both show ``technique`` with the same filter and derivative source: a split starts as a fair
+        comparison, and one key on the active half (a technique, F, Shift+F) makes the difference to look at."""
         names = list(techniques)
         if technique not in names:
             names.append(technique)
-        return cls(names, {"A": Half(technique, filter, derivatives),
-                           "B": Half(_next(names, technique), filter, derivatives)})
+        return cls(names, {side: Half(technique, filter, derivatives) for side in SIDES})
 
     @property
     def side(self) -> str:
@@ -61,6 +61,8 @@ class ViewerState:
 
     def show(self, side: str, technique: str) -> None:
         self.halves[side].technique = technique
+        if side == "A":
+            self.mirror()
 
     def technique_for_key(self, key: str) -> str | None:
         """The scene's technique that number key ``key`` selects (the registry's ``Technique.key``); None when the
@@ -77,23 +79,24 @@ class ViewerState:
         """The scene's technique ``step`` places after the active half's (wrapping around)."""
         return _next(self.techniques, self.active.technique, step)
 
-    def _mirror(self) -> None:
-        # Unsplit, B follows A, so that splitting starts by comparing techniques under the same filter.
+    def mirror(self) -> None:
+        """Unsplit, B follows A (technique, filter, derivative source): a split starts with the same picture on
+        both halves. Split, each half keeps its own; joined again, B keeps what it showed until A changes."""
         if not self.split:
-            self.halves["B"].filter, self.halves["B"].derivatives = self.halves["A"].filter, self.halves["A"].derivatives
+            self.halves["B"] = replace(self.halves["A"])
 
     def cycle_filter(self) -> Half:
         """The active half's next texture filter; returns that half."""
         half = self.active
         half.filter = _next(list(FILTERS), half.filter)
-        self._mirror()
+        self.mirror()
         return half
 
     def cycle_derivatives(self) -> Half:
         """The active half's next derivative source; returns that half."""
         half = self.active
         half.derivatives = _next(list(DERIVATIVE_SOURCES), half.derivatives)
-        self._mirror()
+        self.mirror()
         return half
 
     def toggle_split(self) -> None:

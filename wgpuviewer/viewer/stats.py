@@ -1,9 +1,11 @@
-"""Frame statistics for the viewer: FPS current/min/avg/max, frame time, and GPU time from timestamp
-queries read back asynchronously (a few frames late, never stalling the frame that asked)."""
+"""Statistics for the viewer: FPS current/min/avg/max, frame time, GPU time from timestamp queries read back
+asynchronously (a few frames late, never stalling the frame that asked), and the mean and 95th percentile of each
+A/B half of the cost and error views' heat maps."""
 
 from __future__ import annotations
 
 from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 import wgpu
@@ -84,6 +86,30 @@ class FrameStats:
         if self.gpu_ms:
             out[-1] += f"   GPU {f(self.gpu_time_ms, '.3f')} ms"
         return out
+
+
+@dataclass(frozen=True)
+class Summary:
+    """What a heat map shows over one half of the screen: the mean and 95th percentile of its drawn pixels."""
+
+    mean: float
+    p95: float
+
+
+def split_column(split_x: float, width: int) -> int:
+    """The first column of half B in a map ``width`` wide split at fraction ``split_x`` (as the error view splits)."""
+    return int(round(split_x * width))
+
+
+def half_summaries(values: np.ndarray, split_x: float | None) -> list[Summary | None]:
+    """``Summary`` of each half of a heat map (``values`` (H, W), negative where nothing was drawn): one for the whole
+    map unsplit, [A, B] split at fraction ``split_x``; None for a half where nothing was drawn."""
+    halves = [values] if split_x is None else np.split(values, [split_column(split_x, values.shape[1])], axis=1)
+    out = []
+    for half in halves:
+        drawn = half[half >= 0]
+        out.append(Summary(float(drawn.mean()), float(np.percentile(drawn, 95))) if drawn.size else None)
+    return out
 
 
 #: Bytes between the slots of the resolve buffer: WebGPU's query resolve offset alignment.

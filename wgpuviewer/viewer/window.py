@@ -25,10 +25,13 @@ def toolkit(gui: str):
                 except ImportError:
                     continue
             from rendercanvas.qt import RenderCanvas, loop
+        elif gui == "jupyter":  # a notebook widget through jupyter_rfb (wgpuviewer.view)
+            from rendercanvas.jupyter import RenderCanvas, loop
         else:
             from rendercanvas.auto import RenderCanvas, loop
     except ImportError as error:
-        fix = {"glfw": "pip install 'wgpuviewer[window]'", "qt": "pip install PySide6"}.get(gui, "pip install glfw")
+        fix = {"glfw": "pip install 'wgpuviewer[window]'", "qt": "pip install PySide6",
+               "jupyter": "pip install 'wgpuviewer[notebook]'"}.get(gui, "pip install glfw")
         raise UserError(f"--gui {gui}: the window toolkit is missing ({error}); install it with: {fix}") from None
     return RenderCanvas, loop
 

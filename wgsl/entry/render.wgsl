@@ -7,12 +7,12 @@
 // #include "common/heat.wgsl"
 // #include "common/footprint.wgsl"
 
-// Frame.mode values of fs_color (the window); offscreen rendering reads fs_data's raw targets instead, whose colour
-// follows MODE_ALBEDO too.
+// Frame.mode values of fs_color (the window; renderer.MODES); offscreen rendering reads fs_data's raw targets
+// instead, whose colour follows MODE_ALBEDO too.
 const MODE_COLOR: u32 = 0u;
 const MODE_COST: u32 = 1u;
 const MODE_UV: u32 = 2u;
-const MODE_DEPTH: u32 = 3u;
+const MODE_LAYER_DEPTH: u32 = 3u;  // the hit's layer depth t in the relief, 0 = top
 const MODE_LAYERS: u32 = 4u;
 const MODE_ALBEDO: u32 = 5u;  // the filtered albedo, unlit (the filtering study compares it)
 
@@ -42,13 +42,33 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.world_pos = world.xyz;
     out.normal = (object.normal_matrix * vec4f(in.normal, 0.0)).xyz;
     out.tangent = vec4f((object.model * vec4f(in.tangent.xyz, 0.0)).xyz, in.tangent.w);
-    out.uv = in.uv * object.uv_scale.xy;
+    // glTF's KHR_texture_transform order: scale, then offset (only its fraction: the renderer drops whole tiles)
+    out.uv = in.uv * object.uv_transform.xy + object.uv_transform.zw;
     return out;
 }
 
 struct Shaded {
     color: vec3f,
     hit: TraceResult,
+}
+
+// Camera depth of a traced hit: its distance from the camera along the view axis (the clip w of the
+// perspective projection), in scene units. The hit lies hit.uv - in.uv (uv units) along the surface and its layer
+// depth times height_scale below it, in the tangent frame scaled by the world units per uv unit here (the relief is
+// traced in uv units). Only the outputs that show it call it: the window's colour path skips its derivatives.
+fn hit_view_depth(in: VertexOut, hit: TraceResult) -> f32 {
+    let duv_dx = dpdx(in.uv);
+    let duv_dy = dpdy(in.uv);
+    // the square root of the areas a pixel covers in the world and in uv
+    let world_area = length(cross(dpdx(in.world_pos), dpdy(in.world_pos)));
+    let world_per_uv = sqrt(world_area / max(abs(duv_dx.x * duv_dy.y - duv_dx.y * duv_dy.x), 1e-30));
+    let n_geo = normalize(in.normal);
+    let t_geo = normalize(in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz));
+    let b_geo = cross(n_geo, t_geo) * in.tangent.w;
+    let duv = hit.uv - in.uv;
+    let below = hit.depth * trace_params.height_scale;
+    let p = in.world_pos + world_per_uv * (t_geo * duv.x + b_geo * duv.y - n_geo * below);
+    return (frame.view_proj * vec4f(p, 1.0)).w;
 }
 
 // The derivative source's raw length ratio of this fragment (the `filter` target's w).
@@ -69,13 +89,19 @@ fn shade(in: VertexOut) -> Shaded {
     let to_eye = normalize(frame.camera_pos.xyz - in.world_pos);
     let v_ts = vec3f(dot(to_eye, t_geo), dot(to_eye, b_geo), dot(to_eye, n_geo));
 
-    let hit = trace(in.uv, v_ts, lod);
+    // The search runs on the uv's fraction (exact in float32): under repeat addressing the same texels, but each
+    // step resolved at magnitude < 1 rather than at the tile count (POM's fixed steps would round there). The whole
+    // tiles go back onto the hit, so it stays continuous across tile seams for the derivatives below.
+    let tile = floor(in.uv);
+    var hit = trace(in.uv - tile, v_ts, lod);
+    hit.uv += tile;
     // The filters' footprint: derivatives from the draw's source, taken here, in uniform control flow.
     let derivs = texture_derivatives(in.uv, v_ts, hit);
     filter_stats.flags = derivs.flags;
     filter_ratio = derivs.ratio;
     // A displaced UV outside the face means the ray left the relief through its side: a silhouette.
-    if any(hit.uv < vec2f(0.0)) || any(hit.uv > object.uv_scale.xy) {
+    let face_lo = object.uv_transform.zw;
+    if any(hit.uv < face_lo) || any(hit.uv > face_lo + object.uv_transform.xy) {
         discard;
     }
 
@@ -117,17 +143,28 @@ fn fs_color(in: VertexOut) -> @location(0) vec4f {
     switch frame.mode {
         case MODE_COST: { return vec4f(heat(f32(s.hit.fetches) / frame.cost_scale), 1.0); }
         case MODE_UV: { return vec4f(fract(s.hit.uv), 0.0, 1.0); }
-        case MODE_DEPTH: { return vec4f(vec3f(s.hit.depth), 1.0); }
+        case MODE_LAYER_DEPTH: { return vec4f(vec3f(s.hit.depth), 1.0); }
         case MODE_LAYERS: { return vec4f(vec3f(layer_grey(s.hit.layers)), 1.0); }
+        // nearer is brighter, with no range to know: 1 / (1 + distance)
         default: { return vec4f(s.color, 1.0); }
     }
 }
 
+// The window's camera-depth view (renderer.MODES["depth"]): its own entry point, because the derivatives it takes
+// would cost every other mode of fs_color their time even where the mode skips them (llvmpipe: +11 ms a frame at
+// 480x270). Nearer is brighter, with no range to know: 1 / (1 + distance).
+@fragment
+fn fs_view_depth(in: VertexOut) -> @location(0) vec4f {
+    let s = shade(in);
+    return vec4f(vec3f(1.0 / (1.0 + max(hit_view_depth(in, s.hit), 0.0))), 1.0);
+}
+
 // Offscreen output: the shaded colour plus the raw trace data (uv/depth/cost modes, .npy files). DataOut is
 // generated from the renderer's offscreen targets (wgpuviewer/relief/renderer.py, DATA_OUT): color; data: hit u,
-// hit v, hit depth, fetches (negative: capped) as float bits; layers: depth layers the search used; filtering:
+// hit v, hit layer depth, fetches (negative: capped) as float bits; layers: depth layers the search used; filtering:
 // texels the filter read, depth fetches of its visibility traces and slopes, hidden texels | flags << 24, the
-// derivative source's raw length ratio as float bits (FilterStats, common/footprint.wgsl).
+// derivative source's raw length ratio as float bits (FilterStats, common/footprint.wgsl); view_depth: the hit's
+// camera depth as float bits.
 @fragment
 fn fs_data(in: VertexOut) -> DataOut {
     let s = shade(in);
@@ -135,5 +172,5 @@ fn fs_data(in: VertexOut) -> DataOut {
     let data = vec4f(s.hit.uv, s.hit.depth, select(fetches, -fetches - 1.0, s.hit.capped));
     let stats = vec4u(filter_stats.texels, filter_stats.depth_fetches,
                       min(filter_stats.hidden, 0xffffffu) | (filter_stats.flags << 24u), bitcast<u32>(filter_ratio));
-    return DataOut(vec4f(s.color, 1.0), bitcast<vec4u>(data), s.hit.layers, stats);
+    return DataOut(vec4f(s.color, 1.0), bitcast<vec4u>(data), s.hit.layers, stats, bitcast<u32>(hit_view_depth(in, s.hit)));
 }
