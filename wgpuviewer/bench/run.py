@@ -148,11 +148,23 @@ class Options:
     notes: list[str] = field(default_factory=list)
 
 
+def check_heightmaps(names) -> None:
+    """A UserError naming --heightmaps for a name that is no builtin or scikit-image map, or a scikit-image map
+    without scikit-image (bench and the studies check their option with it before any folder or GPU)."""
+    from wgpuviewer.textures import BUILTINS
+
+    known = (*BUILTINS, *REAL_MAPS)
+    for name in names:
+        if name not in known:
+            raise UserError(f"--heightmaps: unknown height map {name!r}; expected some of {', '.join(known)}")
+        if name in REAL_MAPS and not skimage_available():
+            raise UserError(f"--heightmaps: {name!r} needs scikit-image; install it with "
+                            f"pip install 'wgpuviewer[bench]'")
+
+
 def resolve_options(suite_name: str, resolution=None, heightmaps=None, techniques=None, angles=None,
                     frames=None, backend=None, command="wgpuviewer bench", simd_tile=None) -> Options:
     """Validated run options (UserError naming the option on bad input)."""
-    from wgpuviewer.textures import BUILTINS
-
     suite = harness_suite.pick(SUITES, suite_name)
     notes = []
     if resolution is not None:
@@ -169,14 +181,8 @@ def resolve_options(suite_name: str, resolution=None, heightmaps=None, technique
                 raise UserError(f"--angles: {a:g} out of range; expected 0 to 89 degrees "
                                 f"(the frame spans about 1.5 degrees, and must not look past the horizon)")
         suite = replace(suite, angles=tuple(float(a) for a in angles))
-    known_maps = tuple(BUILTINS) + REAL_MAPS
     if heightmaps is not None:
-        for name in heightmaps:
-            if name not in known_maps:
-                raise UserError(f"--heightmaps: unknown height map {name!r}; expected some of {', '.join(known_maps)}")
-            if name in REAL_MAPS and not skimage_available():
-                raise UserError(f"--heightmaps: {name!r} needs scikit-image; install it with "
-                                f"pip install 'wgpuviewer[bench]'")
+        check_heightmaps(heightmaps)
         suite = replace(suite, heightmaps=tuple(heightmaps))
     elif not skimage_available():
         kept = tuple(h for h in suite.heightmaps if h not in REAL_MAPS)

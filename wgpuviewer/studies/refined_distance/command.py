@@ -23,7 +23,7 @@ class RefinedDistance:
 
     def options(self, args) -> dict:
         """``run.run``'s keyword arguments, each option checked."""
-        from .run import check_heightmaps
+        from wgpuviewer.bench.run import check_heightmaps
 
         angles = comma_numbers(args.angles, "--angles", "45,80")
         if angles is not None and not all(0.0 <= a <= 85.0 for a in angles):

@@ -15,7 +15,6 @@ from pathlib import Path
 import numpy as np
 
 from maptools.cache import cached_generate
-from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import write_bytes
 from wgpuviewer.harness import suite as harness_suite
 from wgpuviewer.harness.header import Clock, Header
@@ -100,21 +99,6 @@ def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[n
     out = cached_generate(variant.kind, height, backend="auto", slices=DISTANCE_SLICES, height_scale=height_scale,
                           **variant.options)
     return out, time.perf_counter() - t0
-
-
-def check_heightmaps(names: list[str]) -> None:
-    """A UserError naming --heightmaps for a name that is no builtin or scikit-image map, or a scikit-image map
-    without scikit-image (checked before the output folder is made or the GPU starts)."""
-    from wgpuviewer.bench.run import REAL_MAPS, skimage_available
-    from wgpuviewer.textures import BUILTINS
-
-    known = (*BUILTINS, *REAL_MAPS)
-    for name in names:
-        if name not in known:
-            raise UserError(f"--heightmaps: unknown height map {name!r}; expected some of {', '.join(known)}")
-        if name in REAL_MAPS and not skimage_available():
-            raise UserError(f"--heightmaps: {name!r} needs scikit-image; install it with "
-                            f"pip install 'wgpuviewer[bench]'")
 
 
 def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str | None = None,
