@@ -9,6 +9,7 @@ from wgpuviewer.relief.renderer import DEPTH_FORMAT, DrawConfig, Renderer
 from wgpuviewer.scene import Camera
 
 from . import error_view
+from .stats import split_column
 
 
 def scene_passes(draws: list[DrawConfig], split_x: float | None, w: int, h: int) -> list:
@@ -58,7 +59,7 @@ class FrameEncoder:
         values = error_of(draws[0])
         if split_x is not None:
             right = error_of(draws[1])
-            xs = int(round(split_x * size[0]))
+            xs = split_column(split_x, size[0])
             values[:, xs:] = right[:, xs:]
         self.error_texels = error_view.texel_size(self.renderer)
         self._error.upload(values)
