@@ -23,7 +23,7 @@ import numpy as np
 
 from . import camera as cam
 from .core.errors import InputError
-from .scene import Camera, Scene, default_scene_path, load_scene, uv_scale_problem, with_folder_material
+from .scene import Camera, Scene, _show, default_scene_path, load_scene, uv_scale_problem, with_folder_material
 
 #: The default frame size of ``render``: the CLI's (``cli.DEFAULT_SIZE``; a test holds them equal, the CLI cannot
 #: import this module before its process is prepared).
@@ -76,11 +76,6 @@ class CameraSpec:
             return cls(**value)
         raise InputError(f"camera = {_show(value)}: expected None, a dict of {', '.join(f.name for f in fields(cls))}"
                          " or a wgpuviewer.CameraSpec")
-
-
-def _show(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def _label(names: dict, key: str, value) -> str:
