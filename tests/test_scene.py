@@ -123,6 +123,7 @@ def test_minimal_scene_defaults(tmp_path):
     assert rock.albedo == TextureRef("color", color=(0.5, 0.4, 0.3))
     assert (rock.normal, rock.height, rock.normal_y, rock.height_scale, rock.uv_scale) == (
         None, None, "opengl", 0.05, (1.0, 1.0))
+    assert (rock.shadows, rock.depth_offset, rock.address) == ("off", False, "repeat")
     assert scene.objects[0].position == (0.0, 0.0, 0.0) and scene.objects[0].rotation == (0.0, 0.0, 0.0)
     with pytest.raises(dataclasses.FrozenInstanceError):
         scene.name = "other"
@@ -243,6 +244,9 @@ def test_unknown_nested_keys(tmp_path, text, parts):
      ["materials.rock.albedo.size = [4.5, 4]", "integers"]),
     (scene_text(objects=OBJECT.replace('"plane"', '"sphere"')), ["objects[0].type = 'sphere'", "plane, quad, box"]),
     (scene_text(material=MATERIAL + "normal_y = 'up'\n"), ["materials.rock.normal_y = 'up'", "opengl, directx"]),
+    (scene_text(material=MATERIAL + "shadows = 'sharp'\n"), ["materials.rock.shadows = 'sharp'", "off, hard, soft"]),
+    (scene_text(material=MATERIAL + "depth_offset = 1\n"), ["materials.rock.depth_offset = 1", "true or false"]),
+    (scene_text(material=MATERIAL + "address = 'mirror'\n"), ["materials.rock.address = 'mirror'", "repeat, clamp"]),
     (scene_text("[scene]\ntechniques = 'pom'"), ["scene.techniques = 'pom'", "array of technique names"]),
     (scene_text(tail="[techniques]\npom = 3\n"), ["techniques.pom = 3", "expected a table"]),
     (scene_text(tail="[techniques.steep]\nlayers = 8.5\n"), ["techniques.steep.layers = 8.5", "integer"]),
@@ -521,3 +525,9 @@ def test_a_named_map_not_built_from_the_materials_height_is_refused_naming_the_k
     text = MAPS_MATERIAL if replace is None else MAPS_MATERIAL.replace(*replace)
     assert text != MAPS_MATERIAL or replace is None
     error(tmp_path, scene_text(material=text), *parts)
+
+
+def test_material_shadows_depth_offset_address(tmp_path):
+    rock = load(tmp_path, scene_text(material=MATERIAL + "shadows = 'soft'\ndepth_offset = true\naddress = 'clamp'\n")
+                ).materials["rock"]
+    assert (rock.shadows, rock.depth_offset, rock.address) == ("soft", True, "clamp")

@@ -73,7 +73,10 @@ class Material:
     relief depth in UV units; ``uv_scale`` tiles the textures and ``uv_offset`` then shifts them, in tiles
     (glTF's KHR_texture_transform order: ``uv * uv_scale + uv_offset``). ``maps``: (slot, file) of the
     precomputed maps the scene names (``[materials.X.maps]``), each checked against the height file it was built
-    from; the renderer serves them instead of building those slots (``maptools.cache.serving``).
+    from; the renderer serves them instead of building those slots (``maptools.cache.serving``). ``shadows``: the
+    relief's self-shadowing (``SHADOW_MODES``); ``depth_offset`` writes the traced hit's depth so other geometry
+    intersects the relief; ``address``: ``repeat`` tiles the textures, ``clamp`` makes the uv square the relief's
+    extent (rays leaving it before a hit are discarded: silhouettes).
     """
 
     name: str
@@ -86,6 +89,15 @@ class Material:
     uv_scale: tuple[float, float] = (1.0, 1.0)
     uv_offset: tuple[float, float] = (0.0, 0.0)
     maps: tuple[tuple[str, TextureRef], ...] = ()
+    shadows: str = "off"
+    depth_offset: bool = False
+    address: str = "repeat"
+
+
+#: Self-shadowing modes of a material (``shadows = ...``; the render flag ``--shadows`` overrides every material).
+SHADOW_MODES = ("off", "hard", "soft")
+#: Texture addressing of a material: ``repeat`` tiles, ``clamp`` ends the relief at the uv domain's edge.
+ADDRESS_MODES = ("repeat", "clamp")
 
 
 @dataclass(frozen=True)
@@ -230,6 +242,12 @@ class _Table:
             raise self.error(name, value, f"expected one of {', '.join(choices)}")
         return value
 
+    def boolean(self, name, default=_MISSING) -> bool:
+        value = self.get(name, default, "true or false")
+        if not isinstance(value, bool):
+            raise self.error(name, value, "expected true or false")
+        return value
+
     def array_of_tables(self, name: str) -> list:
         """``[[name]]`` entries; [] when absent."""
         value = self.data.get(name, [])
@@ -343,7 +361,7 @@ def _light(src: str, key: str, data) -> Light:
 def _material(src: str, name: str, data, base: Path) -> Material:
     t = _Table(src, f"materials.{name}", data,
                ("folder", "albedo", "normal", "normal_y", "height", "depth", "height_scale", "uv_scale", "uv_offset",
-                "channel", "maps"))
+                "channel", "maps", "shadows", "depth_offset", "address"))
     folder = _folder(t, base)
     albedo = _texture(t, "albedo", base, color_ok=True, required=folder is None) or (folder and folder["albedo"])
     if albedo is None:
@@ -381,6 +399,9 @@ def _material(src: str, name: str, data, base: Path) -> Material:
         uv_scale=uv_scale,
         uv_offset=t.vector("uv_offset", 2, [0.0, 0.0]),  # any finite value: the renderer drops its whole tiles
         maps=_named_maps(t, base, height, is_depth),
+        shadows=t.string("shadows", "off", SHADOW_MODES),
+        depth_offset=t.boolean("depth_offset", False),
+        address=t.string("address", "repeat", ADDRESS_MODES),
     )
     if folder is not None:
         report_folder(folder)
