@@ -62,3 +62,8 @@ def build(kind: str, size) -> np.ndarray:
     if kind == "box":
         return box(*size)
     raise ValueError(f"unknown mesh kind {kind!r}")
+
+
+def for_object(obj) -> np.ndarray:
+    """The vertices of a scene object (``scene.SceneObject``), in this module's layout."""
+    return build(obj.kind, obj.size)

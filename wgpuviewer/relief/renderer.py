@@ -183,7 +183,7 @@ class Renderer:
 
     def _build_object(self, index: int, obj):
         device = self.gpu.device
-        vertices = meshes.build(obj.kind, obj.size)
+        vertices = meshes.for_object(obj)
         vbuf = device.create_buffer_with_data(label=f"mesh:{index}", data=vertices, usage=wgpu.BufferUsage.VERTEX)
         model = cam.translation(obj.position) @ cam.rotation_xyz(obj.rotation)
         normal_matrix = np.eye(4)
