@@ -43,6 +43,7 @@ import numpy as np
 
 from wgpuviewer.core import env
 from wgpuviewer.core.errors import FileError, UserError
+from wgpuviewer.core.gpu import format_bytes
 from wgpuviewer.core.io import WriteError, atomic_open, remove_abandoned_temps
 from wgpuviewer.core.sidecar import read_record
 
@@ -341,14 +342,6 @@ def cached_generate(kind: str, height, backend: str = "auto", **options):
     return cached(kind, cache_key(kind, h, opts), lambda: generate(kind, h, backend=backend, **opts))
 
 
-def _size(n: float) -> str:
-    for unit in ("B", "KiB", "MiB", "GiB"):
-        if n < 1024 or unit == "GiB":
-            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
-        n /= 1024
-    return f"{n:.1f} TiB"
-
-
 def _age(seconds: float) -> str:
     for unit, length in (("d", 86400), ("h", 3600), ("min", 60)):
         if seconds >= length:
@@ -362,7 +355,7 @@ def describe() -> str:
     found = entries()
     limit = cache_limit()
     source = f"${CACHE_ENV}" if env.CACHE_DIR.raw() else f"default; set ${CACHE_ENV} to move it"
-    cap = (f"{_size(limit)} (${CACHE_MAX_ENV}, default {env.CACHE_MAX.default_text})" if limit
+    cap = (f"{format_bytes(limit)} (${CACHE_MAX_ENV}, default {env.CACHE_MAX.default_text})" if limit
            else f"none (${CACHE_MAX_ENV}=0)")
     lines = [f"map cache: {cache_dir()} ({source})",
              f"size cap: {cap}; the least recently used maps are evicted beyond it"]
@@ -371,9 +364,9 @@ def describe() -> str:
         kinds.setdefault(e.kind, []).append(e)
     now = time.time()
     for kind, items in sorted(kinds.items()):
-        lines.append(f"  {kind:<17} {len(items):>5} maps  {_size(sum(e.size for e in items)):>10}  "
+        lines.append(f"  {kind:<17} {len(items):>5} maps  {format_bytes(sum(e.size for e in items)):>10}  "
                      f"last used {_age(now - items[-1].last_used)} ago")
     total = sum(e.size for e in found)
-    lines.append(f"total: {len(found)} maps, {_size(total)}" + (f" ({100 * total / limit:.0f} % of the cap)"
+    lines.append(f"total: {len(found)} maps, {format_bytes(total)}" + (f" ({100 * total / limit:.0f} % of the cap)"
                                                                  if limit else ""))
     return "\n".join(lines)
