@@ -16,13 +16,14 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from wgpuviewer.core.cli import OneLineParser, prepare_process, run_command, save_traceback
+from wgpuviewer.core.cli import OneLineParser, prepare_process, run_command, save_traceback, terminal_progress
 from wgpuviewer.core.errors import FileError, UserError
 from wgpuviewer.core.images import HEIGHT_CHANNELS, NAN_POLICIES, read_height
 from wgpuviewer.core.io import output_dir, refuse_directory, remove_stale_temps
 from wgpuviewer.core.sidecar import MapRecord, file_sha256, is_recorded, read_record, record_path, write_record
 
 from . import VERSION, generate, resolve_backend
+from .check import DEFAULT_SAMPLE, DEFAULT_SEED, SAMPLED, check_kinds
 from .io import INPUT_EXTS, write_result
 from .registry import KINDS, get_kind
 
@@ -138,6 +139,13 @@ def build_parser() -> argparse.ArgumentParser:
     chk.add_argument("--kinds", default=None, help="comma-separated kinds (default all)")
     chk.add_argument("--set", action="append", metavar="KIND.OPTION=VALUE",
                      help="a kind's option, e.g. complexity.levels=16 (repeatable; `maptools kinds` lists them)")
+    chk.add_argument("--full", action="store_true",
+                     help="compare every value of every kind (the slow CPU references in full: minutes on a 512x512 "
+                     "map); default: those kinds at a seeded random sample of values")
+    chk.add_argument("--sample", type=int, default=None, metavar="N",
+                     help=f"values compared per sampled kind ({', '.join(SAMPLED)}; default {DEFAULT_SAMPLE})")
+    chk.add_argument("--seed", type=int, default=None, metavar="S",
+                     help=f"seed of the sample (default {DEFAULT_SEED})")
     _add_input_options(chk)
 
     sub.add_parser("kinds", help="list the map kinds and their options")
@@ -358,21 +366,47 @@ def print_table(rows) -> None:
 
 # -- check ------------------------------------------------------------------------------------------
 
+def _sampling(args) -> tuple[int | None, int]:
+    """(values per sampled kind, or None for --full; seed) from --full, --sample, --seed."""
+    if args.full and (args.sample is not None or args.seed is not None):
+        raise UserError("--full compares every value: drop --sample and --seed, or drop --full")
+    if args.sample is not None and args.sample < 1:
+        raise UserError(f"--sample {args.sample}: must be >= 1 (or --full for every value)")
+    if args.seed is not None and args.seed < 0:
+        raise UserError(f"--seed {args.seed}: must be >= 0")
+    seed = DEFAULT_SEED if args.seed is None else args.seed
+    return None if args.full else DEFAULT_SAMPLE if args.sample is None else args.sample, seed
+
+
 def cmd_check(args) -> int:
+    from tqdm import tqdm
+
     from . import gpu
 
     kinds = _parse_kinds(args.kinds)
     kopts = kind_options(kinds, args.set)
+    sample, seed = _sampling(args)
     height = read_height(args.input, args.channel, args.nan_policy)
     g = gpu.runner()  # NoAdapterError (exit 2) when there is no GPU to check
     print(f"{args.input}: {height.shape[1]}x{height.shape[0]} on {g.gpu.summary}")
+    sampled = [k for k in kinds if k in SAMPLED]
+    if sample is None or not sampled:
+        print("comparing every value of every kind")
+    else:
+        print(f"{', '.join(sampled)}: CPU reference at a random sample of {sample} values per kind (seed {seed}; "
+              f"--sample, --seed change it, --full compares every value)")
+    width = max(map(len, kinds))
     bad = 0
-    for k in kinds:
-        kind, opts = get_kind(k), kopts[k]
-        c = kind.compare(kind.cpu(height, **opts), kind.gpu(height, **opts), opts)
-        bad += not c.ok
-        print(f"{k:<11} max {c.max_diff:.3g}  mean {c.mean_diff:.3g}  tolerance: {kind.tolerance}  "
-              f"{'OK' if c.ok else 'MISMATCH'}" + (f"  ({c.detail})" if c.detail else ""))
+    started = time.perf_counter()
+    with terminal_progress("maptools check") as progress:
+        for r in check_kinds(height, kinds, kopts, sample, seed, progress):
+            c, kind = r.comparison, get_kind(r.kind)
+            bad += not c.ok
+            with tqdm.external_write_mode(file=sys.stdout):  # the line above the progress bar, not through it
+                print(f"{r.kind:<{width}}  max {c.max_diff:.3g}  mean {c.mean_diff:.3g}  tolerance: {kind.tolerance}  "
+                      f"{'OK' if c.ok else 'MISMATCH'}" + (f"  ({c.detail})" if c.detail else "")
+                      + f"  [{r.describe(seed)}]", flush=True)
+    print(f"{len(kinds) - bad} of {len(kinds)} kinds within tolerance in {time.perf_counter() - started:.1f} s")
     return 1 if bad else 0
 
 

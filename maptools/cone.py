@@ -22,7 +22,8 @@ positive forward directional derivative. The computation visits bilinear cells C
 
 c(q) = min(max_ratio, bounds) * (1 - STORE_MARGIN). filter="bilinear" then takes the min over the 3x3 texels
 around each texel, which keeps a bilinear lookup of the map (a mix of the 4 texels around p, all neighbours of
-p's own texel) below the nearest-lookup value. The ring walk stops once no further ring can lower any value.
+p's own texel) below the nearest-lookup value. Each texel's ring walk stops once no further ring can lower its
+value, as on the GPU.
 """
 
 from __future__ import annotations
@@ -32,6 +33,8 @@ import math
 import numpy as np
 
 from wgpuviewer.core.errors import UserError
+
+from .distance import index_arrays
 
 #: Relative margin every stored ratio loses (covers float32 arithmetic on the GPU and the float32 store).
 STORE_MARGIN = 2.0 ** -12
@@ -98,39 +101,49 @@ def _n3x3(a: np.ndarray, op) -> np.ndarray:
     return _neigh(a, op, [(dy, dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1) if dy or dx])
 
 
-def raw_ratio(depth: np.ndarray, max_ratio: float) -> np.ndarray:
-    """Nearest-lookup cone ratio (float64, before the store margin) for depth (H, W) float64."""
+def raw_ratio(depth: np.ndarray, max_ratio: float, rows=None, cols=None) -> np.ndarray:
+    """Nearest-lookup cone ratio (float64, before the store margin) for depth (H, W) float64: (H, W), or only at the
+    texels (rows, cols) when given (index arrays; shaped like rows, each value exactly the whole map's). Each texel
+    walks the rings until (a - 0.5) min(1, sy) >= c (M_q - global min depth): no farther cell can lower its ratio
+    (the GPU's rule)."""
     h, w = depth.shape
     sy = w / h
-    cf = cell_fields(depth, sy)
-    m = _n3x3(depth, np.maximum)                            # M_q: max D over the footprint's 4 cells
-    g = _neigh(cf["grad"], np.maximum, [(0, 1), (1, 0), (1, 1)])  # cells (i-1..i, j-1..j) around texel q
+    shape = (h, w) if rows is None else np.shape(rows)
+    if rows is None:
+        rows, cols = (a.ravel() for a in np.indices((h, w)))
+    rows, cols = np.asarray(rows, np.int64).ravel(), np.asarray(cols, np.int64).ravel()
+    cf = {name: f.ravel() for name, f in cell_fields(depth, sy).items()}
+    m = _n3x3(depth, np.maximum)[rows, cols]                 # M_q: max D over the footprint's 4 cells
+    g = _neigh(cf["grad"].reshape(h, w), np.maximum, [(0, 1), (1, 0), (1, 1)])[rows, cols]  # cells around q
     reach = m - depth.min()                                  # M_q - global min depth
-    c = np.full((h, w), float(max_ratio))
-    rows, cols = np.arange(h), np.arange(w)
+    c = np.full(rows.shape, float(max_ratio))
+    live = np.arange(rows.size)                              # texels still walking
     for a in range(ring_count(max_ratio, w, h)):
-        if a >= 1 and (a - 0.5) * min(1.0, sy) >= (c * reach).max():
-            break
+        if a >= 1:
+            live = live[(a - 0.5) * min(1.0, sy) < c[live] * reach[live]]
+            if not live.size:
+                break
+        r, q, m_live = rows[live], cols[live], m[live]
         for di, dj in ring_offsets(a):
-            ix = np.ix_((rows + dj) % h, (cols + di) % w)
-            cmin, mag = cf["cmin"][ix], cf["mag"][ix]
+            cell = ((r + dj) % h) * w + (q + di) % w
+            cmin, mag = cf["cmin"][cell], cf["mag"][cell]
             xs, ys = (di - 0.5, di + 1.5), ((dj - 0.5) * sy, (dj + 1.5) * sy)
             # h is separable (x part + y part), so its max over R's corners is the sum of the two maxima
-            hx = [x * (cf["amax"][ix] if x >= 0 else cf["amin"][ix]) for x in xs]
-            hy = [y * (cf["bmax"][ix] if y >= 0 else cf["bmin"][ix]) for y in ys]
+            hx = [x * (cf["amax"][cell] if x >= 0 else cf["amin"][cell]) for x in xs]
+            hy = [y * (cf["bmax"][cell] if y >= 0 else cf["bmin"][cell]) for y in ys]
             hmax = np.maximum(hx[0], hx[1]) + np.maximum(hy[0], hy[1])
             band = EXIT_BAND * mag * (max(abs(xs[0]), abs(xs[1])) + max(abs(ys[0]), abs(ys[1])) + 1.0)
-            denom = m - cmin
+            denom = m_live - cmin
             may_exit = (mag > 0) & (hmax > -band) & (denom > 0)
             if di in (-1, 0) and dj in (-1, 0):
                 with np.errstate(divide="ignore"):
-                    bound = np.where(may_exit, 1.0 / g, np.inf)
+                    bound = np.where(may_exit, 1.0 / g[live], np.inf)
             else:
                 rho = math.hypot(_axis_rho(di), _axis_rho(dj) * sy)
                 with np.errstate(divide="ignore", invalid="ignore"):
                     bound = np.where(may_exit, rho / np.where(denom > 0, denom, 1.0), np.inf)
-            np.minimum(c, bound, out=c)
-    return c
+            c[live] = np.minimum(c[live], bound)
+    return c.reshape(shape)
 
 
 def to_float32_down(a: np.ndarray) -> np.ndarray:
@@ -150,11 +163,29 @@ def finish(raw: np.ndarray, filter: str) -> np.ndarray:
 
 def cone(height: np.ndarray, *, max_ratio: float = 16.0, filter: str = "bilinear") -> np.ndarray:
     """Relaxed cone ratios, float32 (H, W), texels of u per unit of layer depth t (docs/maps.md)."""
+    _check_options(height, max_ratio, filter)
+    return finish(raw_ratio(depth_of(height), max_ratio), filter)
+
+
+def _check_options(height: np.ndarray, max_ratio: float, filter: str) -> None:
     if filter not in FILTERS:
         raise UserError(f"cone: filter {filter!r}; expected one of {', '.join(FILTERS)}")
     hh, w = height.shape
     check(w, hh, max_ratio)
-    return finish(raw_ratio(depth_of(height), max_ratio), filter)
+
+
+def sample_reference(height: np.ndarray, index, *, max_ratio: float = 16.0, filter: str = "bilinear") -> np.ndarray:
+    """``cone(height, ...)[index]`` for a tuple (row, column) of integer index arrays, computed at those texels
+    (and, for the bilinear filter, their 3 x 3 neighbours) only."""
+    _check_options(height, max_ratio, filter)
+    h, w = height.shape
+    rows, cols = index_arrays(index, (h, w))
+    around = [(dy, dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1)] if filter == "bilinear" else [(0, 0)]
+    near = np.stack([((rows.ravel() + dy) % h) * w + (cols.ravel() + dx) % w for dy, dx in around])
+    texels, where = np.unique(near, return_inverse=True)
+    raw = raw_ratio(depth_of(height), max_ratio, texels // w, texels % w)
+    c = (raw * (1.0 - STORE_MARGIN))[where.reshape(near.shape)].min(axis=0)  # the 3 x 3 min of finish()
+    return to_float32_down(np.maximum(c, 0.0)).reshape(rows.shape)
 
 
 # -- PNG encoding ------------------------------------------------------------------------------------

@@ -21,6 +21,8 @@ interval and a sub-cell's interval, per column the vertical gap from the box's b
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from wgpuviewer.core.errors import UserError
@@ -69,9 +71,8 @@ def vertex_depth(depth: np.ndarray, k: int) -> np.ndarray:
     x0, x1, fx = axis(w)
     y0, y1, fy = axis(h)
     d = np.asarray(depth, np.float64)
-    r0 = d[y0][:, x0] * (1 - fx) + d[y0][:, x1] * fx
-    r1 = d[y1][:, x0] * (1 - fx) + d[y1][:, x1] * fx
-    return r0 * (1 - fy)[:, None] + r1 * fy[:, None]
+    along_u = d[:, x0] * (1 - fx) + d[:, x1] * fx  # (H, W K): rows are interpolated after, each value as before
+    return along_u[y0] * (1 - fy)[:, None] + along_u[y1] * fy[:, None]
 
 
 def subcell_tops(depth: np.ndarray, k: int) -> np.ndarray:
@@ -170,3 +171,70 @@ def distance(height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05
     depth = 1.0 - height.astype(np.float64)
     return store(box_distance(depth, slices, height_scale, subcells))
 
+
+# -- the plain map at given voxels ------------------------------------------------------------------
+
+def index_arrays(index, shape: tuple[int, ...]) -> tuple[np.ndarray, ...]:
+    """A tuple of integer index arrays into an array of ``shape`` as non-negative int64 arrays of one broadcast
+    shape (negative entries count from the end, as numpy's indexing does); an IndexError for one out of range."""
+    if len(index) != len(shape):
+        raise IndexError(f"expected {len(shape)} index arrays, got {len(index)}")
+    out = []
+    for a, n in zip(np.broadcast_arrays(*(np.asarray(a) for a in index)), shape):
+        if a.size and not np.issubdtype(a.dtype, np.integer):
+            raise IndexError(f"index arrays must be integers, got {a.dtype}")
+        a = a.astype(np.int64)
+        if a.size and (a.min() < -n or a.max() >= n):
+            raise IndexError(f"index out of range for an axis of length {n}")
+        out.append(a % n if n else a)
+    return tuple(out)
+
+
+def _pair_gaps(n: int, k: int, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """The offsets ``_gdt_axis`` visits along an axis of n K sub-cells, in its order (o, -1 - o for o = 0, 1, ...),
+    and their squared gaps, computed as it computes them."""
+    pairs = n * k // 2 + 1
+    offsets = np.stack([np.arange(pairs), -1 - np.arange(pairs)], axis=1).ravel()
+    g2 = np.repeat([float(subcell_gap(o, k, step)) ** 2 for o in range(pairs)], 2)
+    return offsets, g2
+
+
+def sample_reference(height: np.ndarray, index, *, slices: int = 16, height_scale: float = 0.05,
+                     subcells: int = 4) -> np.ndarray:
+    """``distance(height, ...)[index]`` for a tuple (slice, row, column) of integer index arrays, computed at those
+    voxels only. Per voxel the least candidate (vertical gap^2 + gap^2 along u) + gap^2 along v over the same
+    sub-cell columns and offsets as the separable transform, in the same float64 order: a window of columns around
+    the voxel, grown until every column outside it is provably no nearer (its gaps alone, plus the slice's least
+    vertical gap, reach the value)."""
+    hh, w = height.shape
+    check_volume(w, hh, slices)
+    check_subcells(subcells, "distance")
+    kk, jj, ii = index_arrays(index, (slices, hh, w))
+    k = subcells
+    tops = subcell_tops(1.0 - height.astype(np.float64), k) * (height_scale * w)
+    bottoms = box_bottoms(slices, height_scale, w)
+    off_x, g2_x = _pair_gaps(w, k, 1.0)
+    off_y, g2_y = _pair_gaps(hh, k, w / hh)
+    least_top = tops.min()
+    out = np.array([_window_min(tops, k, bottoms[z], least_top, j, i, off_x, g2_x, off_y, g2_y)
+                    for z, j, i in zip(kk.ravel(), jj.ravel(), ii.ravel())])
+    return store(np.sqrt(out)).reshape(kk.shape)
+
+
+def _window_min(tops, k, bottom, least_top, j, i, off_x, g2_x, off_y, g2_y) -> float:
+    """min over the sub-cell columns (K j + oy, K i + ox) of (vertical gap^2 + gx^2) + gy^2 (``sample_reference``):
+    a window of offsets reaching ``reach`` texels each way, doubled until no column outside it can be lower."""
+    nky, nkx = tops.shape
+    least = np.square(max(least_top - bottom, 0.0))  # no column's vertical gap is smaller (squared alike)
+    reach = 1.0
+    while True:
+        nx = min(len(off_x), 2 * math.ceil(reach * k))
+        ny = min(len(off_y), 2 * math.ceil(reach * nky / nkx * k))
+        window = tops[(k * j + off_y[:ny]) % nky][:, (k * i + off_x[:nx]) % nkx]
+        best = ((np.maximum(window - bottom, 0.0) ** 2 + g2_x[:nx]) + g2_y[:ny, None]).min()
+        # a column outside the window: its gap along u or along v alone is at least the next offset's
+        outside = min(least + g2_x[nx] if nx < len(off_x) else np.inf,
+                      least + g2_y[ny] if ny < len(off_y) else np.inf)
+        if best <= outside:
+            return float(best)
+        reach *= 2.0

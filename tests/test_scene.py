@@ -220,7 +220,9 @@ def test_unknown_top_level_key(tmp_path):
     (scene_text(camera=CAMERA + "fovy = 50\n"), ["camera.fovy = 50", "unknown key", "position, target, up, fov"]),
     (scene_text("[scene]\ntitle = 'x'"), ["scene.title = 'x'", "allowed: name, technique, techniques"]),
     (scene_text(material=MATERIAL + "roughness = 0.5\n"), ["materials.rock.roughness = 0.5", "albedo, normal"]),
-    (scene_text(objects=OBJECT + "scale = 2\n"), ["objects[0].scale = 2", "type, material, size"]),
+    (scene_text(objects=OBJECT + "scale = 2\n"), ["objects[0].scale = 2", "not used by a plane object",
+                                                   'only type = "mesh" objects take file, node and scale']),
+    (scene_text(objects=OBJECT + "colour = 2\n"), ["objects[0].colour = 2", "type, material, size"]),
     (scene_text(tail="[[lights]]\ntype = 'point'\nposition = [0, 1, 0]\nradius = 1\n"),
      ["lights[0].radius = 1", "unknown key"]),
     (scene_text(material="[materials.rock]\nalbedo = { builtin = 'bricks', sise = [4, 4] }\n"),
@@ -242,7 +244,9 @@ def test_unknown_nested_keys(tmp_path, text, parts):
     (scene_text(material=MATERIAL + "height = [0.5, 0.5, 0.5]\n"), ["materials.rock.height = [0.5, 0.5, 0.5]"]),
     (scene_text(material="[materials.rock]\nalbedo = { builtin = 'bricks', size = [4.5, 4] }\n"),
      ["materials.rock.albedo.size = [4.5, 4]", "integers"]),
-    (scene_text(objects=OBJECT.replace('"plane"', '"sphere"')), ["objects[0].type = 'sphere'", "plane, quad, box"]),
+    (scene_text(objects=OBJECT.replace('"plane"', '"cone"')),
+     ["objects[0].type = 'cone'", "plane, quad, box, sphere, cylinder, torus, mesh"]),
+    (scene_text(objects=OBJECT.replace('"plane"', '"sphere"')), ["objects[0].size = [2.0, 2.0]", "array of 1 numbers"]),
     (scene_text(material=MATERIAL + "normal_y = 'up'\n"), ["materials.rock.normal_y = 'up'", "opengl, directx"]),
     (scene_text(material=MATERIAL + "shadows = 'sharp'\n"), ["materials.rock.shadows = 'sharp'", "off, hard, soft"]),
     (scene_text(material=MATERIAL + "depth_offset = 1\n"), ["materials.rock.depth_offset = 1", "true or false"]),
@@ -531,3 +535,39 @@ def test_material_shadows_depth_offset_address(tmp_path):
     rock = load(tmp_path, scene_text(material=MATERIAL + "shadows = 'soft'\ndepth_offset = true\naddress = 'clamp'\n")
                 ).materials["rock"]
     assert (rock.shadows, rock.depth_offset, rock.address) == ("soft", True, "clamp")
+
+
+# --- curved builtins, meshes and the showcase --------------------------------------------------
+
+
+def test_curved_builtins_take_their_sizes(tmp_path):
+    objects = "".join(f'[[objects]]\ntype = "{kind}"\nmaterial = "rock"\nsize = {size}\n'
+                      for kind, size in (("sphere", "[0.5]"), ("cylinder", "[0.5, 2.0]"), ("torus", "[1.0, 0.25]")))
+    scene = load(tmp_path, scene_text(objects=objects))
+    assert [(o.kind, o.size) for o in scene.objects] == [
+        ("sphere", (0.5,)), ("cylinder", (0.5, 2.0)), ("torus", (1.0, 0.25))]
+
+
+def test_showcase_scene():
+    """Floor, walls, platforms, a glTF mesh, curved builtins, several lights and the relief settings in use."""
+    scene = load_scene(SCENES / "showcase.toml")
+    assert {"plane", "quad", "box", "mesh", "sphere", "torus"} <= {o.kind for o in scene.objects}
+    assert len(scene.lights) >= 2
+    materials = scene.materials.values()
+    assert {m.shadows for m in materials} >= {"hard", "soft"}
+    assert any(m.depth_offset for m in materials) and any(m.address == "clamp" for m in materials)
+    mesh = next(o for o in scene.objects if o.kind == "mesh")
+    assert mesh.file == SCENES / "showcase_assets" / "pillar.gltf" and mesh.scale == (0.9, 0.9, 0.9)
+    assert np.allclose(mesh.size, (0.9 * 0.64, 0.9 * 4.0, 0.9 * 0.64), atol=1e-6)  # the origin-centred box
+
+
+def test_showcase_pillar_is_what_its_script_writes():
+    """The committed pillar.gltf is the output of scenes/showcase_assets.py (its source), byte for byte."""
+    import importlib.util
+    import json
+
+    spec = importlib.util.spec_from_file_location("showcase_assets", SCENES / "showcase_assets.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    written = json.dumps(module.gltf(*module.pillar()), indent=1) + "\n"
+    assert (SCENES / "showcase_assets" / "pillar.gltf").read_text() == written

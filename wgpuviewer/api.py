@@ -23,7 +23,16 @@ import numpy as np
 
 from . import camera as cam
 from .core.errors import InputError
-from .scene import Camera, Scene, _show, default_scene_path, load_scene, uv_scale_problem, with_folder_material
+from .scene import (
+    SHADOW_MODES,
+    Camera,
+    Scene,
+    _show,
+    default_scene_path,
+    load_scene,
+    uv_scale_problem,
+    with_folder_material,
+)
 
 #: The default frame size of ``render``: the CLI's (``cli.DEFAULT_SIZE``; a test holds them equal, the CLI cannot
 #: import this module before its process is prepared).
@@ -243,7 +252,8 @@ def renderer_for(scene: Scene, gpu):
 
 def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEFAULT_SIZE, camera=None,
            mode: str = "color", *, alpha: bool = False, material=None, height_scale=None, uv_scale=None,
-           filter: str | None = None, derivatives: str | None = None, backend: str | None = None) -> np.ndarray:
+           filter: str | None = None, derivatives: str | None = None, shadows: str | None = None,
+           backend: str | None = None) -> np.ndarray:
     """Render a scene offscreen and return the array ``wgpuviewer render -o OUT.npy`` writes.
 
     ``scene``: None (the built-in default scene), a scene .toml path or a ``Scene``; ``technique``: a registry
@@ -253,7 +263,9 @@ def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEF
     where nothing was drawn); ``alpha``: colour and albedo get a fourth channel, 1 where drawn and 0 on the
     background (``render --alpha``). ``material``: a material folder shown on the scene's first plane;
     ``height_scale``, ``uv_scale``: the subject's relief depth and tiling; ``filter``, ``derivatives``: the texture
-    filter and its derivative source (``wgpuviewer filters``); ``backend``: auto, vulkan, metal, dx12 or gl.
+    filter and its derivative source (``wgpuviewer filters``); ``shadows``: "off", "hard" or "soft" for every
+    material (``render --shadows``; None: each material's own ``shadows``); ``backend``: auto, vulkan, metal, dx12
+    or gl.
 
     The maps a technique needs are built on first use (and cached on disk); the renderer of a scene is kept, so
     repeated renders of it (other techniques, cameras, modes) cost only the drawing.
@@ -274,8 +286,11 @@ def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEF
     if mode not in OUTPUT_MODES:
         raise InputError(f"mode = {_show(mode)}: expected one of {', '.join(OUTPUT_MODES)}")
     spec = CameraSpec.of(camera)
+    if shadows is not None and shadows not in SHADOW_MODES:
+        raise InputError(f"shadows = {_show(shadows)}: expected one of {', '.join(SHADOW_MODES)}, or None")
     filtering = {"filter": get_filter(filter or DEFAULT_FILTER, "filter").name,
-                 "derivatives": get_derivatives(derivatives or DEFAULT_DERIVATIVES, "derivatives").name}
+                 "derivatives": get_derivatives(derivatives or DEFAULT_DERIVATIVES, "derivatives").name,
+                 "shadows": shadows}
     scene = scene_of(scene, material, height_scale, uv_scale)
     name = get_technique(technique or scene.technique, "technique").name
     view = camera_for(scene, spec)
@@ -290,7 +305,7 @@ def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEF
 
 def view(scene=None, technique: str | None = None, size: tuple[int, int] = DEFAULT_WIDGET_SIZE, camera=None, *,
          material=None, height_scale=None, uv_scale=None, filter: str | None = None, derivatives: str | None = None,
-         backend: str | None = None):
+         shadows: str | None = None, backend: str | None = None):
     """The interactive viewer (keys, HUD, A/B split) as a Jupyter widget, through rendercanvas's Jupyter backend
     (``jupyter_rfb``): the cell that ends with it shows it, and it draws while a browser shows it. The arguments
     are ``render``'s; ``size`` is the widget's in logical pixels; ``camera`` is where the viewer's cameras start
@@ -305,7 +320,7 @@ def view(scene=None, technique: str | None = None, size: tuple[int, int] = DEFAU
     name = get_technique(technique or scene.technique, "technique").name
     scene = replace(scene, camera=camera_for(scene, spec))
     viewer = Viewer(scene, name, backend, gui="jupyter", size=size, filter=filter or DEFAULT_FILTER,
-                    derivatives=derivatives or DEFAULT_DERIVATIVES)
+                    derivatives=derivatives or DEFAULT_DERIVATIVES, shadows=shadows)
     viewer.window.request_draw(viewer.draw)  # the widget keeps the viewer alive through its draw function
     return viewer.window.canvas
 

@@ -48,11 +48,12 @@ def pick_technique(scene, name: str | None) -> str:
 
 
 def pick_filtering(args) -> dict:
-    """DrawConfig's filter and derivatives from ``--filter`` / ``--derivatives`` (checked against the registry)."""
+    """DrawConfig's filter and derivatives from ``--filter`` / ``--derivatives`` (checked against the registry),
+    and its self-shadowing override from ``--shadows`` (None: each material's own)."""
     from wgpuviewer.relief.filters import get_derivatives, get_filter
 
     return {"filter": get_filter(args.filter, "--filter").name,
-            "derivatives": get_derivatives(args.derivatives, "--derivatives").name}
+            "derivatives": get_derivatives(args.derivatives, "--derivatives").name, "shadows": args.shadows}
 
 
 def has_display() -> bool:
@@ -335,6 +336,7 @@ def cmd_warm(args) -> int:
 
 def add_filter_options(parser) -> None:
     from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER
+    from wgpuviewer.scene import SHADOW_MODES
 
     parser.add_argument("--filter", default=DEFAULT_FILTER,
                         help=f"texture filter for the albedo and normal lookups (default {DEFAULT_FILTER}; "
@@ -342,6 +344,9 @@ def add_filter_options(parser) -> None:
     parser.add_argument("--derivatives", default=DEFAULT_DERIVATIVES,
                         help=f"derivative source the filter's footprint comes from: uv, displaced, analytic "
                         f"(default {DEFAULT_DERIVATIVES})")
+    parser.add_argument("--shadows", choices=SHADOW_MODES,
+                        help="self-shadowing of every material's relief, overriding the materials' `shadows` "
+                        "(default: each material's own)")
 
 
 def measurement_commands() -> list:

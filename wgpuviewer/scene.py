@@ -24,6 +24,7 @@ from wgpuviewer.core.sidecar import file_sha256, is_recorded, read_record
 from wgpuviewer.relief.techniques import TECHNIQUES, get_technique, resolve_params
 
 from . import camera as cam
+from .meshes import BUILTIN_SHAPES, MESH_SUFFIXES, NodeNotFound, load_mesh
 from .textures import (
     BUILTINS,
     FOLDER_EXTS,
@@ -103,7 +104,10 @@ ADDRESS_MODES = ("repeat", "clamp")
 @dataclass(frozen=True)
 class SceneObject:
     """A shape with a material. Plane: in XZ facing +Y, size (width along X, depth along Z);
-    quad: in XY facing +Z, size (width along X, height along Y); box: size (x, y, z).
+    quad: in XY facing +Z, size (width along X, height along Y); box: size (x, y, z); sphere: size (radius,);
+    cylinder: along Y, size (radius, height); torus: around Y, size (major radius, minor radius) (``meshes``).
+    mesh: the triangles of ``file`` (glTF or OBJ; ``node``: one node or object of it), scaled by ``scale``; its
+    ``size`` is that of the origin-centred box holding the scaled mesh.
     ``rotation`` is Euler XYZ in degrees, applied before ``position``.
     """
 
@@ -112,6 +116,9 @@ class SceneObject:
     size: tuple[float, ...]
     position: Vec3 = (0.0, 0.0, 0.0)
     rotation: Vec3 = (0.0, 0.0, 0.0)
+    file: Path | None = None
+    node: str | None = None
+    scale: Vec3 = (1.0, 1.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -132,7 +139,12 @@ class Scene:
     background: Vec3 = (0.02, 0.02, 0.03)
 
 
-OBJECT_SIZES = {"plane": 2, "quad": 2, "box": 3}
+#: Builtin object type -> how many numbers its ``size`` has (``meshes.BUILTIN_SHAPES`` names them).
+OBJECT_SIZES = {kind: len(keys) for kind, (keys, _) in BUILTIN_SHAPES.items()}
+#: Every object type: the builtins and ``mesh`` (a glTF or OBJ file).
+OBJECT_TYPES = (*OBJECT_SIZES, "mesh")
+#: Albedo of a mesh whose file gives it no material.
+MESH_DEFAULT_COLOR = (0.8, 0.8, 0.8)
 #: Most [[lights]] a scene may have: the renderer's Frame uniform holds them all (32 bytes each), and the
 #: shader loops over the scene's count only.
 MAX_LIGHTS = 256
@@ -601,30 +613,82 @@ def with_folder_material(scene: Scene, folder: Path) -> Scene:
                    name=f"{scene.name} with {folder.name}")
 
 
-def _object(src: str, key: str, data, materials: dict[str, Material]) -> SceneObject:
-    t = _Table(src, key, data, ("type", "material", "size", "position", "rotation"))
-    kind = t.string("type", choices=tuple(OBJECT_SIZES))
-    material = t.string("material")
-    if material not in materials:
+_OBJECT_KEYS = ("type", "material", "size", "position", "rotation", "file", "node", "scale")
+_MESH_ONLY = ("file", "node", "scale")
+
+
+def _object(src: str, key: str, data, materials: dict[str, Material], base: Path) -> SceneObject:
+    """An [[objects]] table; a mesh without ``material`` adds the material its file gives to ``materials``."""
+    t = _Table(src, key, data, _OBJECT_KEYS)
+    kind = t.string("type", choices=OBJECT_TYPES)
+    for name in _MESH_ONLY if kind != "mesh" else ("size",):
+        if name in t.data:
+            raise t.error(name, t.data[name], f"not used by a {kind} object; " + (
+                "its size comes from its file: give scale = S or [sx, sy, sz]" if kind == "mesh"
+                else 'only type = "mesh" objects take file, node and scale'))
+    material = t.string("material") if kind != "mesh" or "material" in t.data else None
+    if material is not None and material not in materials:
         raise t.error("material", material, f"unknown material; defined: {', '.join(materials) or 'none'}")
-    return SceneObject(
-        kind=kind,
-        material=material,
-        size=t.vector("size", OBJECT_SIZES[kind], lo=0, exclusive=True),
-        position=t.vector("position", 3, [0.0, 0.0, 0.0]),
-        rotation=t.vector("rotation", 3, [0.0, 0.0, 0.0]),
-    )
+    position = t.vector("position", 3, [0.0, 0.0, 0.0])
+    rotation = t.vector("rotation", 3, [0.0, 0.0, 0.0])
+    if kind != "mesh":
+        size = t.vector("size", OBJECT_SIZES[kind], lo=0, exclusive=True)
+        return SceneObject(kind=kind, material=material, size=size, position=position, rotation=rotation)
+    value = t.string("file")
+    path = (base / Path(value).expanduser()).resolve()
+    if path.suffix.lower() not in MESH_SUFFIXES:
+        raise t.error("file", value, f"unsupported mesh file type; expected {', '.join(MESH_SUFFIXES)}")
+    if not path.is_file():
+        raise t.error("file", value, f"file not found (looked for {path})")
+    node = t.string("node") if "node" in t.data else None
+    scale = ((t.number("scale", 1.0, lo=0, exclusive=True),) * 3 if _is_number(t.get("scale", 1.0, ""))
+             else t.vector("scale", 3, [1.0, 1.0, 1.0], lo=0, exclusive=True))
+    try:
+        mesh = load_mesh(path, node)
+    except NodeNotFound as error:
+        raise t.error("node", node, error.reason) from None
+    except FileError as error:
+        raise t.error("file", value, error.reason) from None
+    if material is None:
+        material = _file_material(t, value, path, node, mesh.material, materials)
+    size = tuple(2 * h for h in mesh.half_extents(scale))
+    return SceneObject(kind=kind, material=material, size=size, position=position, rotation=rotation, file=path,
+                       node=node, scale=scale)
 
 
-_HALF_EXTENTS = {  # object kind -> its half extents (local x, y, z) from its size
+def _file_material(t: _Table, value: str, path: Path, node: str | None, given, materials: dict) -> str:
+    """The name of the material a mesh file gives (``meshes.FileMaterial``, or None: a plain grey), added to
+    ``materials`` under ``FILE`` or ``FILE:NODE`` (a scene material of that name keeps it; the file's is then
+    ``file FILE``)."""
+    name = path.name + (f":{node}" if node is not None else "")
+    if name in materials and not materials[name].name.startswith("file "):
+        name = f"file {name}"
+    origin = f"{t.src}: {t.path('file')} = {_show(value)}"
+    if given is not None and given.albedo is not None:
+        albedo = given.albedo
+    else:
+        color = given.color if given is not None and given.color is not None else MESH_DEFAULT_COLOR
+        albedo = TextureRef("color", color=color, origin=origin)
+    materials.setdefault(name, Material(name=name, albedo=albedo, normal=given and given.normal,
+                                        height=given and given.height))
+    return name
+
+
+_HALF_EXTENTS = {  # object kind -> its half extents (local x, y, z) from its size: the box holding it
     "plane": lambda s: (s[0] / 2, 0.0, s[1] / 2),
     "quad": lambda s: (s[0] / 2, s[1] / 2, 0.0),
     "box": lambda s: (s[0] / 2, s[1] / 2, s[2] / 2),
+    "sphere": lambda s: (s[0], s[0], s[0]),
+    "cylinder": lambda s: (s[0], s[1] / 2, s[0]),
+    "torus": lambda s: (s[0] + s[1], s[1], s[0] + s[1]),
+    "mesh": lambda s: (s[0] / 2, s[1] / 2, s[2] / 2),
 }
 
 
 def _distance_to(obj: SceneObject, point) -> float:
-    """Float64 distance from ``point`` to the surface of ``obj`` (a plane's or quad's rectangle, a box's faces)."""
+    """Float64 distance from ``point`` to the surface of ``obj`` (a plane's or quad's rectangle, a box's faces; the
+    box holding a curved shape or a mesh: a lower bound of the distance outside it, the distance to its faces
+    inside)."""
     rotation = cam.rotation_xyz(obj.rotation)[:3, :3]
     local = np.abs(rotation.T @ (np.asarray(point, np.float64) - obj.position))
     half = np.asarray(_HALF_EXTENTS[obj.kind](obj.size))
@@ -702,7 +766,7 @@ def parse_scene(text: str, path: Path | str | None = None) -> Scene:
     raw_objects = root.array_of_tables("objects")
     if not raw_objects:
         raise root.error("objects", raw_objects, "expected at least one [[objects]] table")
-    objects = tuple(_object(src, f"objects[{i}]", x, materials) for i, x in enumerate(raw_objects))
+    objects = tuple(_object(src, f"objects[{i}]", x, materials, base) for i, x in enumerate(raw_objects))
     camera = _camera(root)
     _check_geometry(src, camera, objects, raw_objects)
 

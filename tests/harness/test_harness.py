@@ -242,7 +242,7 @@ def test_every_command_refuses_a_bad_out_alike_before_anything(tmp_path, monkeyp
 
 @pytest.mark.parametrize("argv, fragment", [
     (["refined-distance", "--heightmaps", "bricks,bogus"], "--heightmaps: unknown height map 'bogus'"),
-    (["refined-distance", "--angles", "86"], "--angles '86'"),
+    (["refined-distance", "--angles", "90"], "--angles '90'"),
     (["bench", "--heightmaps", "bogus"], "--heightmaps: unknown height map 'bogus'"),
     (["bench", "--from-csv", "missing.csv"], "--from-csv missing.csv: no such file"),
     (["filtering", "--reliefs", "lava"], "--reliefs: unknown relief 'lava'"),

@@ -181,6 +181,9 @@ def test_cli_generate(inputs, tmp_path, capsys):
      "--set 'cone.max_ratio=4': cone is not among the kinds selected (normal); add it to --kinds or drop the --set"),
     (["check", "IN", "--kinds", "normal,maxmip", "--set", "complexity.levels=8"],
      "complexity is not among the kinds selected (normal, maxmip)"),
+    (["check", "IN", "--full", "--sample", "100"], "--full compares every value: drop --sample and --seed"),
+    (["check", "IN", "--sample", "0"], "--sample 0: must be >= 1"),
+    (["check", "IN", "--seed", "-1"], "--seed -1: must be >= 0"),
     # ... after its value is checked like a selected kind's
     (["batch", "IN", "-o", "OUT", "--kinds", "normal", "--set", "cone.max_ratio=-5"], "max_ratio"),
     (["batch", "IN", "-o", "OUT", "--kinds", "cone", "--set", "cone.max_ratio=-5"], "max_ratio"),

@@ -21,6 +21,8 @@ from wgpuviewer.relief.techniques import (
     CONE_FINISH_CELLS,
     CONE_HALVINGS_MAX,
     CONE_MAX_RATIO,
+    HANDOVER_STEPS,
+    PYRAMID_STEPS,
     TECHNIQUES,
 )
 from wgpuviewer.textures import builtin_height
@@ -43,8 +45,11 @@ def test_registry_entry_and_map_slot():
     assert tech.ray_search and tech.exact and tech.wgsl_file == "techniques/cone.wgsl" and "cone" in tech.textures
     assert tech.defaults() == {"iterations": 128}
     assert tech.fixed_values() == {"max_ratio": CONE_MAX_RATIO, "halvings_max": CONE_HALVINGS_MAX,
-                                "finish_cells": CONE_FINISH_CELLS}
-    assert tech.fetch_bound({"iterations": 10}) == 20 + CONE_HALVINGS_MAX + CONE_FINISH_CELLS
+                                "finish_cells": CONE_FINISH_CELLS, "handover_steps": HANDOVER_STEPS,
+                                "pyramid_steps": PYRAMID_STEPS}
+    # the grazing finish: maxmip's pyramid walk on the maxmip slot, bounded by PYRAMID_STEPS
+    assert "maxmip" in tech.textures and "maxmip_walk(" in read_wgsl(tech.wgsl_file)
+    assert tech.fetch_bound({"iterations": 10}) == 20 + CONE_HALVINGS_MAX + CONE_FINISH_CELLS + PYRAMID_STEPS
     assert MAP_SLOTS["cone"].derived and not MAP_SLOTS["cone"].scale_bound
     # The map is built for nearest lookups, and the tracer reads it so.
     assert CONE_FILTER == "nearest" and "textureLoad(cone_tex" in read_wgsl(tech.wgsl_file)

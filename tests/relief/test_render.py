@@ -72,7 +72,7 @@ def test_techniques_differ(default_renderer):
                 # distance / distance_refined: one tracer, two maps, one exact picture; the refined map takes fewer steps
                 assert (costs[a] != costs[b]).any(), (a, b)
                 continue
-            assert np.abs(images[a] - images[b]).mean() > 0.3 or np.abs(costs[a] - costs[b]).mean() > 0.5, (a, b)
+            assert np.abs(images[a] - images[b]).mean() > 0.3 or (costs[a] != costs[b]).any(), (a, b)
 
 
 def test_same_input_same_bytes(gpu):

@@ -20,7 +20,15 @@ from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.relief.shaders import pack_trace_params, trace_params
-from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS, TECHNIQUES, Fixed
+from wgpuviewer.relief.techniques import (
+    HANDOVER_STEPS,
+    PYRAMID_STEPS,
+    REFINED_BANDS,
+    REFINED_MAX_ANGLE,
+    REFINED_SECTORS,
+    TECHNIQUES,
+    Fixed,
+)
 from wgpuviewer.scene import default_scene_path, load_scene, parse_scene
 from wgpuviewer.textures import builtin_height
 
@@ -187,7 +195,7 @@ def test_capped_rays_stop_short_and_are_flagged(gpu):
 
 def test_maxmip_pyramid_bounds_every_cell_it_covers():
     """Node i of level m bounds the cells [i 2^m, (i+1) 2^m) (ceil-halving levels, odd sizes included), and the
-    atlas rows are where maxmip.wgsl looks for them."""
+    atlas rows are where common/maxmip_walk.wgsl looks for them."""
     rng = np.random.default_rng(0)
     depth = rng.random((13, 7))
     cells = cell_max_height(depth)
@@ -215,9 +223,12 @@ def test_distance_refined_uses_the_same_tracer():
     assert plain.wgsl_file == refined.wgsl_file == "techniques/distance.wgsl"
     assert plain.params == refined.params
     p, r = plain.fixed_values(), refined.fixed_values()
-    assert p == {"sectors": 1, "bands": 1, "steep_cos": -2, "volumes": 1}
+    finish = {"handover_steps": HANDOVER_STEPS, "pyramid_steps": PYRAMID_STEPS}  # the grazing finish
+    assert p == {"sectors": 1, "bands": 1, "steep_cos": -2, "volumes": 1, **finish}
     assert r == {"sectors": REFINED_SECTORS, "bands": REFINED_BANDS, "volumes": REFINED_SECTORS * REFINED_BANDS + 1,
-                 "steep_cos": pytest.approx(math.cos(math.radians(REFINED_MAX_ANGLE)))}
+                 "steep_cos": pytest.approx(math.cos(math.radians(REFINED_MAX_ANGLE))), **finish}
+    for t in (plain, refined):
+        assert "maxmip" in t.textures and t.fetch_bound({"iterations": 10}) == 20 + PYRAMID_STEPS
 
 
 def test_distance_refined_fetches_against_plain(gpu):

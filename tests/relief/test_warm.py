@@ -58,14 +58,14 @@ def test_a_render_after_warm_builds_no_map(tmp_path, capsys, adapter):
     assert cli.main(["warm", path]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines == ["pom_adaptive: 2 built, 0 already cached", "maxmip: 1 built, 1 already cached",
-                     "cone: 1 built, 1 already cached", "distance: 1 built, 1 already cached",
+                     "cone: 1 built, 2 already cached", "distance: 1 built, 2 already cached",
                      f"map cache: {tmp_path / 'cache'}"], lines
     for technique in TECHNIQUES:
         served = render(path, technique, tmp_path / f"{technique}.png")
         assert served and {s.source for s in served} == {"cache"}, (technique, served)
     capsys.readouterr()
     assert cli.main(["warm", path, "--techniques", "cone,maxmip"]) == 0
-    assert capsys.readouterr().out.splitlines()[:2] == ["cone: 0 built, 2 already cached",
+    assert capsys.readouterr().out.splitlines()[:2] == ["cone: 0 built, 3 already cached",
                                                         "maxmip: 0 built, 2 already cached"]
 
 
@@ -124,4 +124,4 @@ def test_maps_the_scene_names_are_served_from_their_files(tmp_path, capsys, adap
         assert not [s for s in served if s.source == "built" and s.kind == kind], served
     capsys.readouterr()
     assert cli.main(["warm", path, "--techniques", "distance"]) == 0
-    assert capsys.readouterr().out.splitlines()[0] == "distance: 0 built, 1 already cached, 1 from files the scene names"
+    assert capsys.readouterr().out.splitlines()[0] == "distance: 0 built, 2 already cached, 1 from files the scene names"

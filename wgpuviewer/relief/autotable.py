@@ -50,7 +50,11 @@ from .techniques import (
 )
 
 #: Bump when what ``measure`` computes changes (cached tables are then measured again).
-VERSION = 4
+VERSION = 5
+#: The upper edge the table measures the open-ended last bin at (it takes every view up to 90 degrees, grazing ones
+#: included): the steepest angle docs/accuracy.md reports. A candidate that meets the budget at the last bin's lower
+#: edge may miss it by 100 texels here (parallax on a map that is flat but for its peaks).
+LAST_BIN_TOP = 89.9
 #: The parameter holding the layer count auto scales inside a bin, per candidate technique that has one.
 LAYER_PARAM = {"pom": "layers", "relief": "linear_steps"}
 #: The candidates (indices into AUTO_CANDIDATES) whose scaled lower-edge count is measured too: table row
@@ -73,9 +77,10 @@ FIELDS = ("err_p95", "err_p975", "fetches_mean", "fetches_simd", "capped")
 
 
 def edge_angles() -> np.ndarray:
-    """The angles (degrees) the table is measured at: 0, then the bin edges atan(tan0 2^(i / k)), i < AUTO_BINS - 1."""
+    """The angles (degrees) the table is measured at: 0, the bin edges atan(tan0 2^(i / k)), i < AUTO_BINS - 1, and
+    ``LAST_BIN_TOP``: bin b spans angles b and b + 1."""
     tans = AUTO_TAN0 * 2.0 ** (np.arange(AUTO_BINS - 1) / AUTO_BINS_PER_OCTAVE)
-    return np.concatenate([[0.0], np.degrees(np.arctan(tans))])
+    return np.concatenate([[0.0], np.degrees(np.arctan(tans)), [LAST_BIN_TOP]])
 
 
 def bin_of(angle_deg) -> np.ndarray:
@@ -193,9 +198,9 @@ def choose(table: np.ndarray) -> np.ndarray:
     n = len(AUTO_CANDIDATES)
     err, simd = table[:, :, FIELDS.index("err_p975")], table[:, :, FIELDS.index("fetches_simd")]
     weights = np.array([COST_WEIGHTS[name] for name, _ in AUTO_CANDIDATES])[:, None]
-    # bin b spans edges b and b + 1 (edge 0 = angle 0); the last bin is open-ended: its lower edge only
+    # bin b spans edges b and b + 1 (edge 0 = angle 0; the last bin's upper edge is LAST_BIN_TOP)
     lo = np.arange(AUTO_BINS)
-    hi = np.minimum(lo + 1, AUTO_BINS - 1)
+    hi = lo + 1
     err_lo, simd_lo = err[:n, lo].copy(), simd[:n, lo].copy()
     scaled = (lo >= 1) & (lo < AUTO_BINS - 1)  # bins whose lower edge runs the scaled count (scaled_layers)
     for k, c in enumerate(SCALED):

@@ -9,6 +9,9 @@ traces in float32, which cannot hold a fraction of a texel far from the origin (
 float32 is a whole texture): with repeat addressing the integer part of each entry uv is removed in float64
 before tracing and added back to the hit (exact: repeat is periodic); with clamp addressing, rays entering
 farther out than float32 resolves to 1/64 texel are flagged ``capped``. So is any ray whose hit is not finite.
+
+``shadow_probe`` runs the renderer's self-shadowing (``common/shadow.wgsl``: the hard shadow through the technique's
+``trace``, the soft estimate) on given points and lights; compare it with ``wgpuviewer.relief.reference.shadow``.
 """
 
 from __future__ import annotations
@@ -33,6 +36,11 @@ from .techniques import TECHNIQUES, get_technique, resolve_params
 PROBE_RAY = Struct("ProbeRay", [("uv", "vec2f"), ("view", "vec3f")], "storage")  # view: V in tangent space
 PROBE_HIT = Struct("ProbeHit", [("uv", "vec2f"), ("depth", "f32"), ("fetches", "u32"), ("capped", "u32"),
                                 ("layers", "u32")], "storage")
+#: The shadow probe's records (entry/shadow_probe.wgsl): a point in the relief and a light in, its shadows out.
+SHADOW_POINT = Struct("ShadowPoint", [("uv", "vec2f"), ("depth", "f32"), ("light", "vec3f")], "storage")
+SHADOW_OUT = Struct("ShadowOut", [("hard", "f32"), ("soft", "f32"), ("hard_fetches", "u32"),
+                                  ("soft_fetches", "u32"), ("capped", "u32")], "storage")
+SHADOW_ENTRY = "shadow_main"
 WORKGROUP = 64  # @workgroup_size of the probe entry points
 _MAX_GROUPS = 65535  # workgroups along x of a large set (common/probe_index.wgsl folds the 2D grid at this width)
 ENTRY = "probe_main"
@@ -76,6 +84,67 @@ def _kernel(gpu: Gpu, technique_name: str) -> Kernel:
     layout = compute.layout([io_layout_entries(C), material_layout_entries(technique)], "probe")
     module = compose_technique(technique, "probe", records=(PROBE_RAY.generated(), PROBE_HIT.generated()))
     return compute.kernel_of(module, label=f"probe:{technique.name}", fix=FIX, layout=layout)
+
+
+@dataclass
+class ShadowProbeResult:
+    lit: np.ndarray  # (N,) bool: the hard shadow state (True: the light reaches the point)
+    visibility: np.ndarray  # (N,) float32 the soft estimate in [0, 1]
+    hard_fetches: np.ndarray  # (N,) uint32 depth fetches of the hard shadow's trace
+    soft_fetches: np.ndarray  # (N,) uint32 depth fetches of the soft estimate
+    capped: np.ndarray  # (N,) bool: a cap or clamp decided it (grazing light, a capped trace)
+
+
+def _shadow_kernel(gpu: Gpu, technique_name: str) -> Kernel:
+    technique = get_technique(technique_name)
+    C = wgpu.ShaderStage.COMPUTE
+    compute = compute_for(gpu)
+    layout = compute.layout([io_layout_entries(C), material_layout_entries(technique)], "shadow_probe")
+    module = compose_technique(technique, "shadow_probe",
+                               records=(SHADOW_POINT.generated(), SHADOW_OUT.generated()))
+    return compute.kernel_of(module, label=f"shadow_probe:{technique.name}", fix=FIX, layout=layout)
+
+
+def shadow_probe(technique: str, height: np.ndarray, uv, depth, light_dir, height_scale: float = 0.05, *,
+                 backend: str | None = None, **params) -> ShadowProbeResult:
+    """The renderer's hard and soft self-shadowing of N points with ``technique`` on the GPU (repeat addressing).
+
+    height: (H, W) height map in [0, 1]; uv: (N, 2) points' uv in [0, 1) (the renderer traces the uv's fraction);
+    depth: (N,) their layer depths t; light_dir: (N, 3) or (3,) tangent-space directions towards the light.
+    params: technique parameters, validated against the registry.
+    """
+    tech = get_technique(technique)
+    if not (tech.ray_search and tech.needs_depth):
+        names = ", ".join(name for name, t in TECHNIQUES.items() if t.ray_search and t.needs_depth)
+        raise InputError(f"shadow_probe: technique {technique!r} does not trace the relief; those that do: {names}")
+    values = resolve_params(tech, params)
+    height = validate_height(height, "shadow_probe: height", dtype=np.float64, error=InputError)
+    scale = _check_height_scale(height_scale)
+    uv = _rows(uv, 2, "uv")
+    light = _rows(light_dir, 3, "light_dir")
+    t = _rows(np.reshape(real_array(depth, "shadow_probe: depth"), (-1, 1)), 1, "depth")[:, 0]
+    n = max(len(uv), len(light), len(t))
+    try:
+        uv, light, t = np.broadcast_to(uv, (n, 2)), np.broadcast_to(light, (n, 3)), np.broadcast_to(t, (n,))
+    except ValueError:
+        raise InputError(f"shadow_probe: uv has {len(uv)} rows, depth {len(t)} and light_dir {len(light)}; "
+                         "expected equal counts, or one for all") from None
+    if n == 0:
+        return ShadowProbeResult(np.zeros(0, bool), np.zeros(0, np.float32), np.zeros(0, np.uint32),
+                                 np.zeros(0, np.uint32), np.zeros(0, bool))
+    gpu = get_gpu(backend, quiet=True)
+    compute = compute_for(gpu)
+    kernel = _shadow_kernel(gpu, tech.name)
+    points = np.zeros(n, SHADOW_POINT.dtype)
+    points["uv"], points["depth"], points["light"] = uv, t, light
+    point_buf = compute.storage(SHADOW_POINT.pack_many(points), f"shadow_probe:{n} points", FEWER)
+    out_buf = compute.storage(n * SHADOW_OUT.size, f"shadow_probe:shadows of {n} points", FEWER)
+    layout = kernel.pipeline(SHADOW_ENTRY).get_bind_group_layout(1)
+    group = material_bind_group(gpu, layout, tech, height, scale, values, "repeat")
+    out = dispatch(kernel, SHADOW_ENTRY, [group], n, point_buf, out_buf, SHADOW_OUT)
+    return ShadowProbeResult(lit=out["hard"] > 0.5, visibility=out["soft"].copy(),
+                             hard_fetches=out["hard_fetches"].copy(), soft_fetches=out["soft_fetches"].copy(),
+                             capped=out["capped"] != 0)
 
 
 def probe(

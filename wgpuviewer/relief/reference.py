@@ -272,3 +272,118 @@ def view_dir_from_angles(theta_deg, phi_deg) -> np.ndarray:
     # grazing must give V.z == 0 so exact_hit flags it invalid.
     z = np.where(np.mod(theta, 180.0) == 90.0, 0.0, np.cos(t))
     return np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), z], axis=-1)
+
+
+# --- self-shadowing -------------------------------------------------------------------------------------------
+
+#: A shadow ray's own surface: an occluder nearer to the shaded point than this many texels of travel along the
+#: light ray counts as the point itself (its own slope, the search's rounding), not as a shadow. The renderer's
+#: WGSL gets it generated (relief.shaders), so both sides test the same definition.
+SHADOW_TOLERANCE_TEXELS = 1.0
+#: Depth samples the soft shadow estimate takes along the light ray (the GPU's; the reference samples densely).
+SOFT_SHADOW_SAMPLES = 16
+#: The soft shadow's penumbra: an occluder rising this much above the light ray, as the tangent of its elevation
+#: seen from the shaded point, blocks the whole light (a light of about 0.1 rad radius); below it, a linear fade.
+SOFT_SHADOW_PENUMBRA = 0.1
+#: The reference's soft estimate samples the light ray every this many texels of travel (a dense maximum).
+SOFT_REFERENCE_STEP_TEXELS = 0.125
+
+
+@dataclass
+class Shadow:
+    """Result of :func:`shadow` for N shaded points."""
+
+    lit: np.ndarray  # (N,) bool: the hard shadow state, True where the light reaches the point
+    visibility: np.ndarray  # (N,) float64 soft visibility in [0, 1] (0: fully shadowed)
+    occluder_t: np.ndarray  # (N,) float64 layer depth of the light ray's first hit from the top (NaN: not traced)
+    tolerance_t: np.ndarray  # (N,) float64 the tolerance SHADOW_TOLERANCE_TEXELS as layer depth on this ray
+    valid: np.ndarray  # (N,) bool: False where the light ray is too long to walk (grazing light, see exact_hit)
+
+
+def shadow_span(light_dir, height_scale: float, size_wh) -> tuple[np.ndarray, np.ndarray]:
+    """UV travel per unit of layer depth along the light rays (N, 2) and the tolerance as layer depth (N,): one
+    SHADOW_TOLERANCE_TEXELS of travel, infinite for a vertical light (nothing in a height field shadows it)."""
+    light = _as_rows(light_dir, 3, "light_dir")
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        span = light[:, :2] / light[:, 2:3] * height_scale
+        texels = np.hypot(span[:, 0] * size_wh[0], span[:, 1] * size_wh[1])
+        tolerance = np.where(texels > 0.0, SHADOW_TOLERANCE_TEXELS / texels, np.inf)
+    return span, tolerance
+
+
+def shadow(depth, uv, t, light_dir, height_scale, address: str = "repeat", max_cells: int = MAX_CELLS) -> Shadow:
+    """Self-shadowing of N points on (or in) the relief, in float64: point i at ``uv[i]`` (N, 2), layer depth
+    ``t[i]`` (N,), lit by a directional light ``light_dir`` (N, 3) or (3,) in tangent space (towards the light).
+
+    Hard: the light ray enters the relief's top at ``uv + t * L.xy / L.z * S`` and descends towards the point; its
+    exact first hit (:func:`exact_hit`) is the point itself when the light reaches it. The point is lit iff that hit
+    lies at most SHADOW_TOLERANCE_TEXELS of travel before it (``occluder_t >= t - tolerance_t``). A light at or
+    below the horizon (L.z <= 0) shadows the point; a point within the tolerance of the top is lit.
+
+    Soft, from the surface point at ``uv`` (t0 = D(uv), whatever ``t`` says: a search stopping a little below the
+    surface would otherwise see the relief rise right above it): visibility = clamp(1 - max_s (t_s - D(uv_s)) /
+    ((t0 - t_s) tan theta_L) / SOFT_SHADOW_PENUMBRA, 0, 1) over the light ray's points s from the tolerance to the
+    top (t_s in [0, t0 - tolerance_t], uv_s where the ray is at layer depth t_s; tan theta_L = |L.xy| / L.z): the
+    largest elevation at which the relief rises above the light ray, as seen from the point (Tatarchuk's penumbra
+    estimate, normalised per unit distance). The reference takes the maximum over points every
+    SOFT_REFERENCE_STEP_TEXELS of travel; the GPU over SOFT_SHADOW_SAMPLES of them.
+    """
+    d = _check_depth(depth)
+    check_address(address)
+    p = _as_rows(uv, 2, "uv")
+    light = _as_rows(light_dir, 3, "light_dir")
+    depth_t = real_array(t, "t").reshape(-1)
+    if not np.isfinite(depth_t).all():
+        raise InputError("t contains NaN/inf")
+    n = max(len(p), len(light), len(depth_t))
+    try:
+        p, light = np.broadcast_to(p, (n, 2)), np.broadcast_to(light, (n, 3))
+        depth_t = np.broadcast_to(depth_t, (n,))
+    except ValueError:
+        raise InputError(f"uv has {len(p)} rows, t {len(depth_t)} and light_dir {len(light)}; expected equal "
+                         "counts, or one for all") from None
+    scale = real_number(height_scale, "height_scale")
+    if not np.isfinite(scale) or scale < 0.0:
+        raise InputError(f"height_scale must be finite and >= 0, got {height_scale!r}")
+    rows, cols = d.shape
+    span, tolerance = shadow_span(light, scale, (cols, rows))
+    above = light[:, 2] > 0.0
+    near_top = above & (depth_t <= tolerance)  # no room for an occluder: lit
+    traced = above & ~near_top
+    lit = near_top.copy()
+    surface_t = bilinear(d, p, address)
+    visibility = (above & (surface_t <= tolerance)).astype(np.float64)
+    occluder_t = np.full(n, np.nan)
+    valid = np.ones(n, bool)
+    idx = np.flatnonzero(traced)
+    if idx.size:
+        entry = p[idx] + depth_t[idx, None] * span[idx]
+        hit = exact_hit(d, entry, light[idx], scale, address, max_cells)
+        occluder_t[idx] = hit.t
+        valid[idx] = hit.valid
+        lit[idx] = hit.valid & (hit.t >= depth_t[idx] - tolerance[idx])
+    walkable = np.ones(n, bool)  # a light ray too long to walk gets no soft estimate either: shadowed
+    walkable[idx] = valid[idx]
+    soft = np.flatnonzero(above & (surface_t > tolerance) & walkable)
+    if soft.size:
+        visibility[soft] = _soft_visibility(d, p[soft], surface_t[soft], light[soft], span[soft], tolerance[soft],
+                                            address)
+    return Shadow(lit=lit, visibility=visibility, occluder_t=occluder_t, tolerance_t=tolerance, valid=valid)
+
+
+def _soft_visibility(d, uv, t, light, span, tolerance, address: str) -> np.ndarray:
+    """The soft visibility of :func:`shadow` for traced points (t > tolerance, L.z > 0), sampled densely."""
+    rows, cols = d.shape
+    reach = t - tolerance  # layer depth from the top to the nearest sample
+    texels = SHADOW_TOLERANCE_TEXELS / tolerance  # texels of travel per unit layer depth
+    steps = np.maximum(np.ceil(reach * texels / SOFT_REFERENCE_STEP_TEXELS), 1).astype(np.int64)
+    tan_light = np.hypot(light[:, 0], light[:, 1]) / light[:, 2]
+    worst = np.zeros(len(t))
+    # Rays are walked together, each over its own number of steps: fraction k / steps of its reach, k = 0..steps.
+    for k in range(int(steps.max()) + 1):
+        frac = np.minimum(k / steps, 1.0)
+        t_s = reach * (1.0 - frac)  # from the nearest sample (k = 0) up to the top
+        uv_s = uv + (t - t_s)[:, None] * span
+        rise = (t_s - bilinear(d, uv_s, address)) / ((t - t_s) * tan_light)
+        worst = np.maximum(worst, rise)
+    return np.clip(1.0 - worst / SOFT_SHADOW_PENUMBRA, 0.0, 1.0)

@@ -4,7 +4,8 @@ What to draw comes per draw as a frozen ``DrawConfig`` (technique, its parameter
 texture filter with its parameters and the derivative source it is given); the renderer holds no per-technique
 state of its own beyond caches. Everything is built lazily from what the drawn technique needs ("model only what
 a scene needs"): a material's depth texture exists only once a technique that traces depth is drawn, pipelines are
-compiled on first use and cached per technique x filter x derivative source (only the drawn filter is compiled).
+compiled on first use and cached per technique x filter x derivative source x material variant (only the drawn
+filter is compiled; shadow code only for materials that shadow: ``shaders.MaterialVariant``).
 ``Renderer.created`` logs each GPU resource it builds, so tests (and curious users) can see exactly what a scene
 cost.
 """
@@ -26,7 +27,8 @@ from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, allocating, create_texture, format_bytes, mip_chain
 from wgpuviewer.core.images import read_header
 from wgpuviewer.core.structs import FragmentOutputs
-from wgpuviewer.scene import Camera, Scene
+from wgpuviewer.core.wgsl import Generated
+from wgpuviewer.scene import SHADOW_MODES, Camera, Scene
 
 from . import autotable
 from .filters import (
@@ -41,7 +43,18 @@ from .filters import (
 )
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
 from .probe import probe
-from .shaders import FRAME, LIGHT, MAX_LIGHTS, OBJECT, compose_technique, pack_trace_params, trace_params_size
+from .shaders import (
+    FRAME,
+    LIGHT,
+    MAX_LIGHTS,
+    OBJECT,
+    PLAIN,
+    MaterialVariant,
+    compose_technique,
+    pack_trace_params,
+    trace_params_size,
+    traces_relief,
+)
 from .techniques import Technique, get_technique, resolve_params
 
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
@@ -61,6 +74,16 @@ DATA_OUT = FragmentOutputs("DataOut", [
     ("view_depth", "u32", VIEW_DEPTH_FORMAT),
 ])
 OFFSCREEN_FORMATS = DATA_OUT.formats
+
+
+def hit_depth_outputs(outputs: FragmentOutputs) -> Generated:
+    """``outputs``' struct as ``NAMEHitDepth`` with the depth builtin after its targets: the output of the entry
+    points of depth_offset materials (``fs_data_hit_depth``), the targets from the same list."""
+    lines = outputs.wgsl().rstrip("\n").split("\n")
+    name = f"{outputs.name}HitDepth"
+    lines[0] = f"struct {name} {{"
+    lines.insert(-1, "    @builtin(frag_depth) frag_depth: f32,")
+    return Generated(f"<generated: struct {name}>", "\n".join(lines) + "\n")
 
 #: Bytes per pixel of the offscreen targets and the depth attachment.
 _PIXEL_BYTES = {"rgba8unorm-srgb": 4, "rgba32uint": 16, "r32uint": 4, "depth32float": 4}
@@ -91,15 +114,21 @@ class DrawConfig:
     filter: str = DEFAULT_FILTER
     filter_params: tuple[tuple[str, object], ...] = ()  # (name, value) for every parameter of the filter
     derivatives: str = DEFAULT_DERIVATIVES
+    #: Self-shadowing for every material (scene.SHADOW_MODES), overriding each material's ``shadows``; None: each
+    #: material's own.
+    shadows: str | None = None
 
     @classmethod
     def of(cls, technique: str, params: dict | None = None, height_scale: float | None = None, *,
            filter: str = DEFAULT_FILTER, filter_params: dict | None = None,
-           derivatives: str = DEFAULT_DERIVATIVES) -> DrawConfig:
+           derivatives: str = DEFAULT_DERIVATIVES, shadows: str | None = None) -> DrawConfig:
         t = get_technique(technique)
         f = get_filter(filter)
+        if shadows is not None and shadows not in SHADOW_MODES:
+            raise UserError(f"shadows = {shadows!r}; expected one of {', '.join(SHADOW_MODES)}")
         return cls(t.name, tuple(resolve_params(t, params).items()), height_scale, f.name,
-                   tuple(resolve_filter_params(f, filter_params).items()), get_derivatives(derivatives).name)
+                   tuple(resolve_filter_params(f, filter_params).items()), get_derivatives(derivatives).name,
+                   shadows)
 
     @property
     def values(self) -> dict:
@@ -150,6 +179,7 @@ class Renderer:
         if like is not None:
             self._textures, self._pipelines, self._material_layouts = like._textures, like._pipelines, like._material_layouts
             self._frame_layout, self._object_layout, self._sampler = like._frame_layout, like._object_layout, like._sampler
+            self._clamp_sampler = like._clamp_sampler
             self._filter_layout, self._samplers = like._filter_layout, like._samplers
             self._depth_ranges = like._depth_ranges
         else:
@@ -165,6 +195,11 @@ class Renderer:
             )
             self._sampler = device.create_sampler(
                 label="material", address_mode_u="repeat", address_mode_v="repeat",
+                mag_filter="linear", min_filter="linear", mipmap_filter="linear", max_anisotropy=1,
+            )
+            # address = "clamp" materials: the uv square is the relief's extent
+            self._clamp_sampler = device.create_sampler(
+                label="material:clamp", address_mode_u="clamp-to-edge", address_mode_v="clamp-to-edge",
                 mag_filter="linear", min_filter="linear", mipmap_filter="linear", max_anisotropy=1,
             )
             self._filter_layout = device.create_bind_group_layout(
@@ -316,8 +351,9 @@ class Renderer:
             size=trace_params_size(technique),
             usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST,
         )
+        clamp = self.scene.materials[material_name].address == "clamp"
         entries = [{"binding": PARAMS_BINDING, "resource": {"buffer": params}},
-                   {"binding": SAMPLER_BINDING, "resource": self._sampler}]
+                   {"binding": SAMPLER_BINDING, "resource": self._clamp_sampler if clamp else self._sampler}]
         entries += [
             {"binding": binding(t), "resource": self.texture(material_name, t).create_view()}
             for t in technique.textures
@@ -348,22 +384,37 @@ class Renderer:
             )
         return self._filter_groups[key]
 
-    def module(self, technique: Technique, filter: str = DEFAULT_FILTER, derivatives: str = DEFAULT_DERIVATIVES):
-        """The composed render module (``core.wgsl.Module``) of a technique with a filter and derivative source."""
-        return compose_technique(technique, "render", filter, derivatives, records=(DATA_OUT.generated(),))
+    def module(self, technique: Technique, filter: str = DEFAULT_FILTER, derivatives: str = DEFAULT_DERIVATIVES,
+               variant: MaterialVariant = PLAIN):
+        """The composed render module (``core.wgsl.Module``) of a technique with a filter, derivative source and
+        material variant."""
+        return compose_technique(technique, "render", filter, derivatives,
+                                 records=(DATA_OUT.generated(), hit_depth_outputs(DATA_OUT)), variant=variant)
+
+    def variant(self, material_name: str, technique: Technique, draw: DrawConfig) -> MaterialVariant:
+        """The material variant a material is drawn with: its ``shadows`` (the draw's override first),
+        ``depth_offset`` and ``address``; shadows and the hit's depth only where the technique traces the relief."""
+        material = self.scene.materials[material_name]
+        traced = traces_relief(technique)
+        shadows = material.shadows if draw.shadows is None else draw.shadows
+        return MaterialVariant(shadows if traced else "off", material.depth_offset and traced,
+                               material.address == "clamp")
 
     def pipeline(self, technique: Technique, formats: tuple[str, ...], filter: str = DEFAULT_FILTER,
-                 derivatives: str = DEFAULT_DERIVATIVES, mode: str = "color") -> wgpu.GPURenderPipeline:
-        """The render pipeline of a technique with a filter and derivative source into ``formats``: one target
-        draws ``fs_color`` (``fs_view_depth`` for ``mode`` "depth"), more draw ``fs_data`` (OFFSCREEN_FORMATS)."""
-        entry = fragment_entry(formats, mode)
-        key = (technique.name, filter, derivatives, formats, entry)
+                 derivatives: str = DEFAULT_DERIVATIVES, mode: str = "color",
+                 variant: MaterialVariant = PLAIN) -> wgpu.GPURenderPipeline:
+        """The render pipeline of a technique with a filter, derivative source and material variant into
+        ``formats``: one target draws ``fs_color`` (``fs_view_depth`` for ``mode`` "depth"), more draw ``fs_data``
+        (OFFSCREEN_FORMATS); a depth_offset variant draws their ``_hit_depth`` entry points."""
+        entry = fragment_entry(formats, mode, variant.depth_offset)
+        key = (technique.name, filter, derivatives, formats, entry, variant)
         if key not in self._pipelines:
             device = self.gpu.device
             what = technique.name if (filter, derivatives) == (DEFAULT_FILTER, DEFAULT_DERIVATIVES) \
                 else f"{technique.name}/{filter}/{derivatives}"
+            what += variant.label
             label = f"render:{what}:{entry}:{'+'.join(formats)}"
-            code = self.module(technique, filter, derivatives).code
+            code = self.module(technique, filter, derivatives, variant).code
             module = device.create_shader_module(label=label, code=code)
             layout = device.create_pipeline_layout(
                 label=label,
@@ -387,7 +438,8 @@ class Renderer:
                     "targets": [{"format": f} for f in formats],
                 },
             )
-            self.created.append(f"pipeline:{what}:{'+'.join(formats)}" + ("" if entry != "fs_view_depth" else ":depth"))
+            depth_view = mode == "depth" and len(formats) == 1
+            self.created.append(f"pipeline:{what}:{'+'.join(formats)}" + (":depth" if depth_view else ""))
         return self._pipelines[key]
 
     # --- frames ------------------------------------------------------------------------------
@@ -398,15 +450,16 @@ class Renderer:
         file (``file:line:column: reason``, core.wgsl.Module.locate)."""
         failures = []
         for key in list(self._pipelines):
-            name, filter, derivatives, formats, entry = key
+            name, filter, derivatives, formats, entry, variant = key
             technique = get_technique(name)
             old = self._pipelines.pop(key)
             try:
-                self.pipeline(technique, formats, filter, derivatives, "depth" if entry == "fs_view_depth" else "color")
+                self.pipeline(technique, formats, filter, derivatives,
+                              "depth" if entry.startswith("fs_view_depth") else "color", variant)
             except wgpu.GPUError as error:
                 self._pipelines[key] = old
                 try:
-                    message = self.module(technique, filter, derivatives).locate(str(error))
+                    message = self.module(technique, filter, derivatives, variant).locate(str(error))
                 except OSError as read_error:
                     message = str(read_error)
                 failures.append((technique, message))
@@ -460,7 +513,6 @@ class Renderer:
         technique = get_technique(draw.technique)
         params = draw.values
         self._write_frame(camera, size, mode, technique, params)
-        pipeline = self.pipeline(technique, formats, draw.filter, draw.derivatives, mode)
         filter_group = self._filter_group(draw)
         groups = {}
         for material_name in {m for m, *_ in self._objects}:
@@ -491,10 +543,15 @@ class Renderer:
         )
         if scissor is not None:
             rpass.set_scissor_rect(*scissor)
-        rpass.set_pipeline(pipeline)
+        pipelines = {m: self.pipeline(technique, formats, draw.filter, draw.derivatives, mode,
+                                      self.variant(m, technique, draw)) for m in groups}
         rpass.set_bind_group(0, self._frame_group)
         rpass.set_bind_group(FILTER_GROUP, filter_group)
+        bound = None
         for material_name, vbuf, count, object_group in self._objects:
+            if pipelines[material_name] is not bound:
+                bound = pipelines[material_name]
+                rpass.set_pipeline(bound)
             rpass.set_bind_group(1, groups[material_name])
             rpass.set_bind_group(2, object_group)
             rpass.set_vertex_buffer(0, vbuf)
@@ -618,11 +675,11 @@ def _reported_against(ref, kind: str):
         raise ref.error(f"its {kind} map cannot be built: {error}") from None
 
 
-def fragment_entry(formats: tuple[str, ...], mode: str) -> str:
-    """The fragment entry point of render.wgsl that draws into ``formats`` in ``mode``."""
-    if len(formats) > 1:
-        return "fs_data"
-    return "fs_view_depth" if mode == "depth" else "fs_color"
+def fragment_entry(formats: tuple[str, ...], mode: str, hit_depth: bool = False) -> str:
+    """The fragment entry point of render.wgsl that draws into ``formats`` in ``mode``; ``hit_depth``: the one
+    that also writes the traced hit's depth (depth_offset materials)."""
+    entry = "fs_data" if len(formats) > 1 else "fs_view_depth" if mode == "depth" else "fs_color"
+    return entry + "_hit_depth" if hit_depth else entry
 
 
 def offset_fraction(uv_offset: tuple[float, float]) -> tuple[float, float]:

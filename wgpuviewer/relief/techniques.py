@@ -41,6 +41,11 @@ CONE_FILTER = "nearest"
 #: y border) plus the cell its start may round into.
 CONE_HALVINGS_MAX = 24
 CONE_FINISH_CELLS = 4
+#: The grazing finish of distance and cone (common/maxmip_walk.wgsl): after this many slow steps (slow_step there) a
+#: ray goes on with the max-pyramid walk, for at most PYRAMID_STEPS steps (four times maxmip's default cap: at 89.9
+#: degrees a ray on the 256x256 bricks map needs more than 1024).
+HANDOVER_STEPS = 8
+PYRAMID_STEPS = 4096
 
 
 @dataclass(frozen=True)
@@ -252,6 +257,18 @@ def distance_fixed(sectors: int, bands: int, max_angle: float | None) -> tuple[F
             Fixed("volumes", volumes, "u32"))
 
 
+DISTANCE_COST = (f"one volume fetch per step + one 2x2 gather per exact cell; a grazing ray's pyramid walk up to "
+                 f"{PYRAMID_STEPS}")
+
+
+def distance_fetch_bound(p: dict) -> int:
+    return 2 * p["iterations"] + PYRAMID_STEPS
+
+
+#: The TraceParams values of the grazing finish (distance and cone).
+GRAZING_FINISH = (Fixed("handover_steps", HANDOVER_STEPS, "u32"), Fixed("pyramid_steps", PYRAMID_STEPS, "u32"))
+
+
 TECHNIQUES: dict[str, Technique] = {
     t.name: t
     for t in (
@@ -333,10 +350,12 @@ TECHNIQUES: dict[str, Technique] = {
             "distance", "9",
             "Distance-map parallax (Donnelly): sphere tracing through a 3D map of safe radii (box-exact distance to a "
             "sub-cell outer solid); where the radius does not leave the current bilinear cell the cell is solved "
-            "exactly and skipped if it holds no hit. Never passes a surface.",
-            "one volume fetch per step + one 2x2 gather per exact cell", ("albedo", "normal", "depth", "distance"),
+            "exactly and skipped if it holds no hit. A grazing ray finishes with maxmip's pyramid walk. Never passes a "
+            "surface.",
+            DISTANCE_COST, ("albedo", "normal", "depth", "distance", "maxmip"),
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
-            ray_search=True, fixed=distance_fixed(1, 1, None), fetch_bound=lambda p: 2 * p["iterations"], exact=True,
+            ray_search=True, fixed=distance_fixed(1, 1, None) + GRAZING_FINISH, fetch_bound=distance_fetch_bound,
+            exact=True,
             cost_view_scale=common_cost_scale, layers_view_range=no_layers,
             contract_params=({"iterations": 8},), accuracy_settings=({},),
         ),
@@ -346,11 +365,10 @@ TECHNIQUES: dict[str, Technique] = {
             f"(distance.wgsl); the map has one volume per bin of ray directions ({REFINED_SECTORS} azimuth sectors x "
             f"{REFINED_BANDS} polar bands within {REFINED_MAX_ANGLE:g} degrees) with longer safe steps for "
             "the rays of that bin, and the plain volume for steeper rays. A ray picks its volume once.",
-            "one volume fetch per step + one 2x2 gather per exact cell",
-            ("albedo", "normal", "depth", "distance_refined"),
+            DISTANCE_COST, ("albedo", "normal", "depth", "distance_refined", "maxmip"),
             (Param("iterations", 256, 1, 4096, int, "cap on steps (sphere steps + exact cells); capped rays flagged"),),
-            ray_search=True, wgsl="distance.wgsl", fetch_bound=lambda p: 2 * p["iterations"], exact=True,
-            fixed=distance_fixed(REFINED_SECTORS, REFINED_BANDS, REFINED_MAX_ANGLE),
+            ray_search=True, wgsl="distance.wgsl", fetch_bound=distance_fetch_bound, exact=True,
+            fixed=distance_fixed(REFINED_SECTORS, REFINED_BANDS, REFINED_MAX_ANGLE) + GRAZING_FINISH,
             cost_view_scale=common_cost_scale, layers_view_range=no_layers,
             contract_params=({"iterations": 8},), accuracy_settings=({},),
         ),
@@ -420,14 +438,14 @@ TECHNIQUES: dict[str, Technique] = {
             "exactly and moves on; a cone step that ends in the relief is halved to one cell and solved exactly. "
             "Never passes a surface.",
             "1 packed cone texel per skip; 1 gather per solved cell (+ the texel where a cone could leave it); a bracket "
-            f"adds up to {CONE_HALVINGS_MAX} halvings and {CONE_FINISH_CELLS} cells: "
-            f"at most 2*iterations + {CONE_HALVINGS_MAX + CONE_FINISH_CELLS}",
-            ("albedo", "normal", "depth", "cone"),
+            f"adds up to {CONE_HALVINGS_MAX} halvings and {CONE_FINISH_CELLS} cells; a grazing ray's pyramid walk up "
+            f"to {PYRAMID_STEPS}: at most 2*iterations + {CONE_HALVINGS_MAX + CONE_FINISH_CELLS + PYRAMID_STEPS}",
+            ("albedo", "normal", "depth", "cone", "maxmip"),
             (Param("iterations", 128, 1, 4096, int, "cap on steps (cell solves + cone skips); capped rays flagged"),),
             ray_search=True, exact=True,
             fixed=(Fixed("max_ratio", CONE_MAX_RATIO, "f32"), Fixed("halvings_max", CONE_HALVINGS_MAX, "u32"),
-                   Fixed("finish_cells", CONE_FINISH_CELLS, "u32")),
-            fetch_bound=lambda p: 2 * p["iterations"] + CONE_HALVINGS_MAX + CONE_FINISH_CELLS,
+                   Fixed("finish_cells", CONE_FINISH_CELLS, "u32"), *GRAZING_FINISH),
+            fetch_bound=lambda p: 2 * p["iterations"] + CONE_HALVINGS_MAX + CONE_FINISH_CELLS + PYRAMID_STEPS,
             cost_view_scale=common_cost_scale, layers_view_range=no_layers,
             contract_params=({"iterations": 8},), accuracy_settings=({},),
         ),

@@ -67,6 +67,7 @@ class Viewer:
         background: bool | None = None,
         filter: str = DEFAULT_FILTER,
         derivatives: str = DEFAULT_DERIVATIVES,
+        shadows: str | None = None,
     ):
         toolkit(gui)  # a missing toolkit fails before any map is built
         self.settings = settings or Settings()
@@ -86,6 +87,7 @@ class Viewer:
         self.params = {name: dict(values) for name, values in scene.technique_params.items()}
         self.height_scales: dict[str, float] = {}
         self.state = ViewerState.start(scene.techniques, technique, filter, derivatives)
+        self.state.shadows = shadows
         self.filter_params = {name: f.defaults() for name, f in FILTERS.items()}  # live, per filter
         self.mode = "color"
         self.camera_mode = s.camera_mode
@@ -234,10 +236,11 @@ class Viewer:
 
     def draw_config(self, half: Half) -> DrawConfig:
         """What a pass of ``half`` draws: its technique's live parameters and height-scale override, its filter with
-        its live parameters and its derivative source."""
+        its live parameters and its derivative source, and the self-shadowing override (L)."""
         name = half.technique
         return DrawConfig.of(name, self.technique_params(name), self.height_scales.get(name), filter=half.filter,
-                             filter_params=self.filter_params[half.filter], derivatives=half.derivatives)
+                             filter_params=self.filter_params[half.filter], derivatives=half.derivatives,
+                             shadows=self.state.shadows)
 
     def cost_scale(self, side: str = "A") -> float:
         """The fetch count the cost view paints as full heat on half ``side``."""
@@ -276,6 +279,10 @@ class Viewer:
 
     def cycle_filter(self, key: str):
         self.state.cycle_filter()
+
+    def cycle_shadows(self, key: str):
+        self.state.cycle_shadows()
+        self.message(f"shadows: {self.state.shadows_label}")
 
     def cycle_derivatives(self, key: str):
         half = self.state.cycle_derivatives()
@@ -425,13 +432,13 @@ class Viewer:
 def run_viewer(
     scene: Scene, technique: str, *, backend=None, frames=None, screenshot=None, keys=(),
     gui: str = "glfw", settings: Settings | None = None, size=None, save: bool | None = None,
-    filter: str = DEFAULT_FILTER, derivatives: str = DEFAULT_DERIVATIVES,
+    filter: str = DEFAULT_FILTER, derivatives: str = DEFAULT_DERIVATIVES, shadows: str | None = None,
 ) -> int:
     """Open the window. Interactive runs save the settings on exit (``save``); scripted ones don't."""
     frames = runner.scripted_frames(frames, screenshot, keys)
     scripted = frames is not None
     viewer = Viewer(scene, technique, backend, gui=gui, settings=settings, size=size, scripted=scripted,
-                    filter=filter, derivatives=derivatives)
+                    filter=filter, derivatives=derivatives, shadows=shadows)
     if not scripted:
         print("keys: F1 help, 1-9 technique, F filter, B A/B split, Shift+D cost, Shift+E error, H hide UI, Esc quit",
               file=sys.stderr)

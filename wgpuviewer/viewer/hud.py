@@ -280,6 +280,7 @@ class Hud:
                 imgui.text(heading)
             self._half(half, tag)
             imgui.separator()
+        imgui.text(f"shadows (L): {state.shadows_label}")
         for i, mode in enumerate(("color", "cost", "error")):
             if i:
                 imgui.same_line()

@@ -57,6 +57,8 @@ CONTROLS = (
     Control("F", "next texture filter (in A/B: of the active half); the HUD names it", ("f",), "cycle_filter"),
     Control("Shift+F", "next derivative source of the filter's footprint (uv, displaced, analytic)", ("F",),
             "cycle_derivatives"),
+    Control("L", "self-shadowing: the materials' own, then off, hard, soft for every material; the HUD names it",
+            ("l", "L"), "cycle_shadows"),
     Control("B", "A/B split between two techniques or filters; drag the divider", ("b", "B"), "toggle_split"),
     Control("Tab", "the half of the A/B split the keys change", ("Tab",), "switch_half"),
     Control("P", "save a screenshot PNG (scene only) in the current directory", ("p", "P"), "request_screenshot"),

@@ -1,5 +1,6 @@
 """What the viewer shows, without a window or a GPU: the scene's techniques, the two halves of the A/B split (each a
-``Half``: technique, texture filter, derivative source), which half the keys change, and the divider.
+``Half``: technique, texture filter, derivative source), which half the keys change, the divider, and the
+self-shadowing override (both halves: ``shadows``).
 
 The key actions that only change this state are transitions here, so tests drive them directly; whatever needs maps
 built or a window (switching to a technique whose maps are missing, vsync, fullscreen) stays in the app.
@@ -10,10 +11,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS
+from wgpuviewer.scene import SHADOW_MODES
 
 from .keys import TECHNIQUE_KEYS, technique_key
 
 SIDES = ("A", "B")
+#: What L steps through: None (each material's own ``shadows``), then every mode for all materials.
+SHADOW_CHOICES = (None, *SHADOW_MODES)
 
 
 @dataclass
@@ -36,6 +40,7 @@ class ViewerState:
     split: bool = False
     active_side: str = "A"
     split_x: float = 0.5  # the divider, as a fraction of the width
+    shadows: str | None = None  # self-shadowing for every material (scene.SHADOW_MODES); None: each material's own
 
     @classmethod
     def start(cls, techniques, technique: str, filter: str, derivatives: str) -> ViewerState:
@@ -98,6 +103,16 @@ class ViewerState:
         half.derivatives = _next(list(DERIVATIVE_SOURCES), half.derivatives)
         self.mirror()
         return half
+
+    def cycle_shadows(self) -> str | None:
+        """The next self-shadowing override (SHADOW_CHOICES); returns it."""
+        self.shadows = SHADOW_CHOICES[(SHADOW_CHOICES.index(self.shadows) + 1) % len(SHADOW_CHOICES)]
+        return self.shadows
+
+    @property
+    def shadows_label(self) -> str:
+        """How the HUD names the override: 'materials' (each its own), or the mode for all."""
+        return "materials" if self.shadows is None else self.shadows
 
     def toggle_split(self) -> None:
         """Split or join the screen; either way the keys change half A next."""

@@ -7,7 +7,7 @@
 //   q = floor(D * 16383) (rounded down: the leaf's surface is never below the true one, by at most 6.1e-5);
 // - a node of level m >= 2 holds the maxima of its four children (level m - 1; float32 bits; maptools' max
 //   pyramid over the cells' corner maxima): one fetch tells which children the ray passes above.
-// The walk is maxmip's (integer cell state, box exits; wgsl/techniques/maxmip.wgsl) with three changes:
+// The walk is maxmip's (integer cell state, box exits; wgsl/common/maxmip_walk.wgsl) with three changes:
 // it starts at level top = floor(log2(ray reach in texels)) + top_offset (at least 1) instead of the root
 // (coarse nodes of a rough map all reach the top of the relief: visiting them buys nothing); the node
 // test reads the parent's texel, kept (one for even, one for odd levels), so going to a sibling or back up

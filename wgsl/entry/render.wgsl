@@ -2,8 +2,9 @@
 // filter's lookups at the hit and the thesis' shading model (ambient 0.2 * albedo, Lambert diffuse,
 // Blinn-Phong 0.2 * pow(., 32)). Composed after the generated interfaces (MAX_LIGHTS among them), one technique
 // file, one filter (`filter_texture`), one derivative source (`texture_derivatives`) and one shading_normal
-// snippet (wgpuviewer/relief/shaders.py). The Frame, Light and Object structs are generated from shaders.FRAME and
-// shaders.OBJECT.
+// snippet, one shadow snippet (`light_visibility`, common/shadow_MODE.wgsl) and the material variant's constants
+// (RELIEF_CLAMP) (wgpuviewer/relief/shaders.py). The Frame, Light and Object structs are generated from shaders.FRAME
+// and shaders.OBJECT; DataOut and DataOutHitDepth from renderer.DATA_OUT.
 // #include "common/heat.wgsl"
 // #include "common/footprint.wgsl"
 
@@ -52,11 +53,10 @@ struct Shaded {
     hit: TraceResult,
 }
 
-// Camera depth of a traced hit: its distance from the camera along the view axis (the clip w of the
-// perspective projection), in scene units. The hit lies hit.uv - in.uv (uv units) along the surface and its layer
-// depth times height_scale below it, in the tangent frame scaled by the world units per uv unit here (the relief is
+// Clip position of a traced hit. The hit lies hit.uv - in.uv (uv units) along the surface and its layer depth
+// times height_scale below it, in the tangent frame scaled by the world units per uv unit here (the relief is
 // traced in uv units). Only the outputs that show it call it: the window's colour path skips its derivatives.
-fn hit_view_depth(in: VertexOut, hit: TraceResult) -> f32 {
+fn hit_clip(in: VertexOut, hit: TraceResult) -> vec4f {
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
     // the square root of the areas a pixel covers in the world and in uv
@@ -68,7 +68,20 @@ fn hit_view_depth(in: VertexOut, hit: TraceResult) -> f32 {
     let duv = hit.uv - in.uv;
     let below = hit.depth * trace_params.height_scale;
     let p = in.world_pos + world_per_uv * (t_geo * duv.x + b_geo * duv.y - n_geo * below);
-    return (frame.view_proj * vec4f(p, 1.0)).w;
+    return frame.view_proj * vec4f(p, 1.0);
+}
+
+// Camera depth of a traced hit: its distance from the camera along the view axis (the clip w of the
+// perspective projection), in scene units.
+fn hit_view_depth(in: VertexOut, hit: TraceResult) -> f32 {
+    return hit_clip(in, hit).w;
+}
+
+// The depth buffer's value at a traced hit (depth_offset materials): reversed Z (camera.perspective), so a hit
+// below the surface is farther, and other geometry between the surface and the hit shows through.
+fn hit_frag_depth(in: VertexOut, hit: TraceResult) -> f32 {
+    let clip = hit_clip(in, hit);
+    return clamp(clip.z / max(clip.w, 1e-30), 0.0, 1.0);
 }
 
 // The derivative source's raw length ratio of this fragment (the `filter` target's w).
@@ -91,17 +104,20 @@ fn shade(in: VertexOut) -> Shaded {
 
     // The search runs on the uv's fraction (exact in float32): under repeat addressing the same texels, but each
     // step resolved at magnitude < 1 rather than at the tile count (POM's fixed steps would round there). The whole
-    // tiles go back onto the hit, so it stays continuous across tile seams for the derivatives below.
-    let tile = floor(in.uv);
+    // tiles go back onto the hit, so it stays continuous across tile seams for the derivatives below. Clamp
+    // addressing has one tile, the uv square.
+    let tile = select(floor(in.uv), vec2f(0.0), RELIEF_CLAMP);
     var hit = trace(in.uv - tile, v_ts, lod);
+    let traced_uv = hit.uv;
     hit.uv += tile;
     // The filters' footprint: derivatives from the draw's source, taken here, in uniform control flow.
     let derivs = texture_derivatives(in.uv, v_ts, hit);
     filter_stats.flags = derivs.flags;
     filter_ratio = derivs.ratio;
-    // A displaced UV outside the face means the ray left the relief through its side: a silhouette.
-    let face_lo = object.uv_transform.zw;
-    if any(hit.uv < face_lo) || any(hit.uv > face_lo + object.uv_transform.xy) {
+    // Clamp addressing: the uv square is the relief's extent; a hit outside it means the ray left the relief
+    // through its side before meeting it (the segment from an entry inside the square to a hit inside stays in
+    // it): a silhouette. Repeat addressing tiles the relief on past the face's edge.
+    if RELIEF_CLAMP && (any(hit.uv < vec2f(0.0)) || any(hit.uv > vec2f(1.0))) {
         discard;
     }
 
@@ -125,8 +141,9 @@ fn shade(in: VertexOut) -> Shaded {
         let l = vec3f(dot(l_world, t_geo), dot(l_world, b_geo), dot(l_world, n_geo));
         let diffuse = max(dot(l, n), 0.0) * albedo;
         let specular = 0.2 * pow(max(dot(n, normalize(l + v_ts)), 0.0), 32.0);
-        color += (diffuse + specular) * radiance;
+        color += (diffuse + specular) * radiance * light_visibility(traced_uv, hit.depth, l, lod);
     }
+    hit.fetches += shadow_fetches;  // the cost of the shadow rays, shown with the view ray's
     return Shaded(color, hit);
 }
 
@@ -137,9 +154,7 @@ fn layer_grey(n: u32) -> f32 {
 }
 
 // Window/surface output: one target, the Frame.mode decides what is shown.
-@fragment
-fn fs_color(in: VertexOut) -> @location(0) vec4f {
-    let s = shade(in);
+fn fs_color_of(s: Shaded) -> vec4f {
     switch frame.mode {
         case MODE_COST: { return vec4f(heat(f32(s.hit.fetches) / frame.cost_scale), 1.0); }
         case MODE_UV: { return vec4f(fract(s.hit.uv), 0.0, 1.0); }
@@ -150,12 +165,20 @@ fn fs_color(in: VertexOut) -> @location(0) vec4f {
     }
 }
 
+@fragment
+fn fs_color(in: VertexOut) -> @location(0) vec4f {
+    return fs_color_of(shade(in));
+}
+
 // The window's camera-depth view (renderer.MODES["depth"]): its own entry point, because the derivatives it takes
 // would cost every other mode of fs_color their time even where the mode skips them (llvmpipe: +11 ms a frame at
 // 480x270). Nearer is brighter, with no range to know: 1 / (1 + distance).
 @fragment
 fn fs_view_depth(in: VertexOut) -> @location(0) vec4f {
-    let s = shade(in);
+    return view_depth_color(in, shade(in));
+}
+
+fn view_depth_color(in: VertexOut, s: Shaded) -> vec4f {
     return vec4f(vec3f(1.0 / (1.0 + max(hit_view_depth(in, s.hit), 0.0))), 1.0);
 }
 
@@ -165,12 +188,41 @@ fn fs_view_depth(in: VertexOut) -> @location(0) vec4f {
 // texels the filter read, depth fetches of its visibility traces and slopes, hidden texels | flags << 24, the
 // derivative source's raw length ratio as float bits (FilterStats, common/footprint.wgsl); view_depth: the hit's
 // camera depth as float bits.
-@fragment
-fn fs_data(in: VertexOut) -> DataOut {
-    let s = shade(in);
+fn data_out(in: VertexOut, s: Shaded) -> DataOut {
     let fetches = f32(s.hit.fetches);
     let data = vec4f(s.hit.uv, s.hit.depth, select(fetches, -fetches - 1.0, s.hit.capped));
     let stats = vec4u(filter_stats.texels, filter_stats.depth_fetches,
                       min(filter_stats.hidden, 0xffffffu) | (filter_stats.flags << 24u), bitcast<u32>(filter_ratio));
     return DataOut(vec4f(s.color, 1.0), bitcast<vec4u>(data), s.hit.layers, stats, bitcast<u32>(hit_view_depth(in, s.hit)));
+}
+
+@fragment
+fn fs_data(in: VertexOut) -> DataOut {
+    return data_out(in, shade(in));
+}
+
+// The entry points of depth_offset materials: as above, and the hit's depth into the depth buffer. Writing
+// frag_depth turns the early depth test off for the whole draw, so only those materials' pipelines use them.
+struct ColorHitDepth {
+    @location(0) color: vec4f,
+    @builtin(frag_depth) depth: f32,
+}
+
+@fragment
+fn fs_color_hit_depth(in: VertexOut) -> ColorHitDepth {
+    let s = shade(in);
+    return ColorHitDepth(fs_color_of(s), hit_frag_depth(in, s.hit));
+}
+
+@fragment
+fn fs_view_depth_hit_depth(in: VertexOut) -> ColorHitDepth {
+    let s = shade(in);
+    return ColorHitDepth(view_depth_color(in, s), hit_frag_depth(in, s.hit));
+}
+
+@fragment
+fn fs_data_hit_depth(in: VertexOut) -> DataOutHitDepth {
+    let s = shade(in);
+    let d = data_out(in, s);
+    return DataOutHitDepth(d.color, d.data, d.layers, d.filtering, d.view_depth, hit_frag_depth(in, s.hit));
 }

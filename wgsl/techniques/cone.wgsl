@@ -26,12 +26,16 @@
 // 4. a cone step [t_free, t] that ended solid holds ONE solid interval [t*, t]: halve it with exact bilinear
 //    depths (1 gather each) until it spans at most one cell, then solve the cells it crosses exactly (at most 3,
 //    plus the one its start may round into): the first root is t*.
-// Bounded: `iterations` steps of at most 2 fetches, then halvings_max halvings and finish_cells cells (fixed values
-// from the registry). A ray whose bracket the halvings cannot bring to one cell (float32 t runs out first) or whose
+// A grazing ray skims the relief: its cones stay narrow and it advances a cell or two per step. After handover_steps
+// such slow steps (common/maxmip_walk.wgsl's slow_step) it finishes with the max-pyramid walk from t_free
+// (common/maxmip_walk.wgsl, at most pyramid_steps steps), which skips whole nodes the ray passes above.
+// Bounded: `iterations` steps of at most 2 fetches, then halvings_max halvings and finish_cells cells, or the
+// pyramid walk's pyramid_steps (fixed values from the registry). A ray whose bracket the halvings cannot bring to one cell (float32 t runs out first) or whose
 // finish finds no root to rounding ends at the bracket's free end, flagged.
 // A capped ray returns its last free point t_free, flagged (short of the hit, never behind it).
 // Grazing, horizontal and back-facing views are clamped by parallax_span and flagged (is_grazing).
 // #include "common/cell.wgsl"
+// #include "common/maxmip_walk.wgsl"
 
 // (ratio c, footprint min depth d_q) of the texel q under the cell-coordinate point p: floor(u * W) = floor(x + 0.5).
 fn cone_texel_at(p: vec2f, wh: vec2i) -> vec2f {
@@ -53,6 +57,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     let k = length(span) * f32(wh.x);       // texels of u per unit t (the cone map's metric)
     let widest = trace_params.max_ratio;    // the map's largest stored ratio
     let cap = clamp(trace_params.iterations, ITERATIONS_MIN, ITERATIONS_MAX);
+    let cells_per_t = max(abs(dir.x), abs(dir.y));
     var t = relief_range(0.0).x;  // depth_min (common/trace.wgsl)
     var t_free = t;     // the ray is free on [0, t_free]
     var cell = vec2i(floor(start + t * dir));
@@ -60,7 +65,11 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     // at the floor of the relief): the cell is solved first.
     var crawl = widest * (1.0 - t) <= (walk_node(cell, 0u, wh, start, dir).t_exit - t) * (k + widest);
     var bracketed = false;
+    var slow = 0u;
     for (var i = 0u; i < cap; i++) {
+        if slow >= trace_params.handover_steps {
+            return maxmip_walk(uv0, v, t_free, trace_params.pyramid_steps);
+        }
         let n = walk_node(cell, 0u, wh, start, dir);
         if n.t_exit <= t && t < 1.0 {
             // A cone step's end rounded into a cell the ray has already left: move on (no fetch, no stall).
@@ -73,6 +82,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
             if t < texel.y {
                 let t_cone = t + (texel.y - t) * texel.x / (k + texel.x);
                 if t_cone > n.t_exit && t_cone > t {
+                    slow += slow_step(t, t_cone, cells_per_t);
                     t_free = t;
                     t = t_cone;
                     cell = vec2i(floor(start + t * dir));
@@ -100,6 +110,7 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
             t_next = max(t_next, t + (apex - t) * texel.x / (k + texel.x));
         }
         crawl = t_next <= n.t_exit;
+        slow += slow_step(t, t_next, cells_per_t);
         if crawl {
             t = n.t_exit;
             cell = next_cell(start, dir, t, n.exits, n.lo, n.hi);
@@ -114,7 +125,6 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     // [lo, hi]: free at lo, solid at hi, one solid interval inside.
     var lo = t_free;
     var hi = t;
-    let cells_per_t = max(abs(dir.x), abs(dir.y));
     for (var h = 0u; h < trace_params.halvings_max && (hi - lo) * cells_per_t > 1.0; h++) {
         let mid = 0.5 * (lo + hi);
         let p = start + mid * dir;

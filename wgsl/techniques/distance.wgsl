@@ -11,12 +11,15 @@
 // radii shrink towards 0 and sphere tracing crawls), the cell is solved exactly (cell_hit, common/cell.wgsl) and
 // left at its exit if it holds no hit: the tracer never passes through a surface and its hit is exact to float32.
 // The search starts at the map's shallowest depth (depth_min): above it the ray meets nothing.
-// Bounded by `iterations` (capped rays are flagged and stop short of the surface, never behind it).
+// A grazing ray skims the relief: its radii stay short and it advances a cell or two per step. After handover_steps
+// such slow steps (common/maxmip_walk.wgsl's slow_step) it finishes with the max-pyramid walk from where it is
+// (common/maxmip_walk.wgsl, at most pyramid_steps steps), which skips whole nodes the ray passes above.
+// Bounded by `iterations` and pyramid_steps (capped rays are flagged and stop short of the surface, never behind it).
 // #include "common/cell.wgsl"
+// #include "common/maxmip_walk.wgsl"
 // #include "common/wrap.wgsl"
 
 const PI: f32 = 3.14159265358979;
-
 // The volume a ray with span `span` (parallax_span) reads, as maptools.refined.volume_index decides it:
 // trace_params.sectors (azimuth sectors), bands (polar bands, edge k at cos = steep_cos^(k / bands)), steep_cos (cosine
 // of the binned cone's half-angle; -2: every ray is binned) and volumes describe the texture
@@ -51,8 +54,13 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     let dir = -span * size;
     let per_t = size.x * length(vec3f(span, trace_params.height_scale));
     let cap = clamp(trace_params.iterations, ITERATIONS_MIN, ITERATIONS_MAX);
+    let cells_per_t = max(abs(dir.x), abs(dir.y));
     var t = relief_range(0.0).x;  // depth_min (common/trace.wgsl)
+    var slow = 0u;
     for (var step = 0u; step < cap; step++) {
+        if slow >= trace_params.handover_steps {
+            return maxmip_walk(uv0, v, t, trace_params.pyramid_steps);
+        }
         let texel = vec2i(floor((uv0 - span * t) * size));
         let k = clamp(i32(floor(t * f32(slices))), 0, slices - 1);
         fetch_count += 1u;
@@ -65,13 +73,16 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
         // Take the safe sphere step when it leaves the current cell; a shorter one (near the surface,
         // where radii shrink towards 0) would crawl, so solve the cell exactly instead.
         if t_sphere >= t_exit && radius > 0.0 {
-            t = min(t_sphere, 1.0);
+            let t_next = min(t_sphere, 1.0);
+            slow += slow_step(t, t_next, cells_per_t);
+            t = t_next;
             continue;
         }
         let t_hit = cell_hit(cell, start, dir, t, t_exit);
         if t_hit >= 0.0 {
             return TraceResult(uv0 - span * t_hit, t_hit, fetch_count, is_grazing(v), 0u);
         }
+        slow += slow_step(t, max(t, t_exit), cells_per_t);  // a solved cell: one cell further
         t = max(t, t_exit);
     }
     return TraceResult(uv0 - span * t, t, fetch_count, true, 0u);

@@ -1,68 +1,11 @@
-// Maximum-mipmap tracing (Romanyuk & Dudnyk 2018, modified MIP pyramid), exact on the bilinear surface.
-//
-// The surface between four texel centres (a "cell", texel coordinates x = u * W - 0.5) is a bilinear
-// patch, never higher than its highest corner. maps.py builds level 0 of the pyramid as that corner
-// maximum per cell (wrap) and the coarser levels with maptools' maxmip kind (ceil-halving sizes; a
-// parent covers at least the children 2i, 2i+1), so node i of level m bounds the cells
-// [i * 2^m, (i + 1) * 2^m) of its row/column from above. The levels sit in one r32float atlas
-// (level m at rows [row_m, row_m + h_m)), read with textureLoad: no sampler, no mip rules.
-//
-// Traversal: start at the top, at the map's shallowest depth; at a node, compute where the ray leaves the node's
-// cells; if it is still above the node's highest point there (t_exit < 1 - max), skip the node and look at the next
-// one on the same level while it has the same parent (that parent was entered because the ray may reach its relief:
-// testing it again would only descend again), else from one level up; otherwise descend. At level 0 the cell's
-// exact quadratic is solved (cell_hit, common/cell.wgsl), so the first hit matches wgpuviewer/reference.py to float32
-// precision, thin walls and spikes included. The current cell is tracked as integers (stepped explicitly on exits),
-// so rounding can never make the walk stall or go back. Bounded by max_steps (capped rays are flagged).
-// Addressing: the pyramid wraps (repeat), as the renderer's sampler does.
-// #include "common/cell.wgsl"
-
-const MAXMIP_LEVELS: u32 = 16u;
-// Float32 rounding of the stored maxima (height -> depth): skip only with this much room to spare.
-const MAXMIP_MARGIN: f32 = 1e-6;
+// Maximum-mipmap tracing (Romanyuk & Dudnyk 2018, modified MIP pyramid), exact on the bilinear surface: the
+// pyramid walk of common/maxmip_walk.wgsl from the map's shallowest depth (above it the ray meets nothing:
+// relief_range, common/trace.wgsl). At level 0 the cell's exact quadratic is solved, so the first hit matches
+// wgpuviewer/reference.py to float32 precision, thin walls and spikes included. Bounded by max_steps (capped rays
+// are flagged).
+// #include "common/maxmip_walk.wgsl"
 
 fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
     fetch_count = 0u;
-    let wh = vec2i(textureDimensions(depth_tex, 0));
-    // Atlas row of each level; sizes ceil-halve down to 1x1 (maptools.cpu.level_sizes).
-    var rows: array<i32, MAXMIP_LEVELS>;
-    var lw = wh;
-    var levels = 1u;
-    while (lw.x > 1 || lw.y > 1) && levels < MAXMIP_LEVELS {
-        rows[levels] = rows[levels - 1u] + lw.y;
-        lw = (lw + 1) / 2;
-        levels += 1u;
-    }
-    let top = levels - 1u;
-    let span = parallax_span(v);
-    let size = vec2f(wh);
-    let start = uv0 * size - 0.5;
-    let dir = -span * size;  // texel coordinates per unit t
-    // Above the map's shallowest depth the ray meets nothing: the walk starts there (relief_range, common/trace.wgsl).
-    var t = relief_range(0.0).x;
-    var cell = vec2i(floor(start + t * dir));
-    var level = top;
-    let cap = clamp(trace_params.max_steps, MAX_STEPS_MIN, MAX_STEPS_MAX);
-    for (var step = 0u; step < cap; step++) {
-        let n = walk_node(cell, level, wh, start, dir);
-        if level > 0u {
-            fetch_count += 1u;
-            let top_height = textureLoad(maxmip_tex, vec2i(n.index.x, rows[level] + n.index.y), 0).r;
-            if n.t_exit >= 1.0 - top_height - MAXMIP_MARGIN {
-                level -= 1u;  // the ray may reach this node's relief: look closer
-                continue;
-            }
-        } else {
-            let t_hit = cell_hit(cell, start, dir, t, n.t_exit);
-            if t_hit >= 0.0 {
-                return TraceResult(uv0 - span * t_hit, t_hit, fetch_count, is_grazing(v), 0u);
-            }
-        }
-        // Nothing in this node: step into the next one along the ray, on this level within the same parent.
-        t = max(t, n.t_exit);
-        cell = next_cell(start, dir, t, n.exits, n.lo, n.hi);
-        let same_parent = all((wrap_texel(cell, wh) >> vec2u(level + 1u)) == (n.index >> vec2u(1u)));
-        level = select(min(level + 1u, top), level, same_parent && level < top);
-    }
-    return TraceResult(uv0 - span * t, t, fetch_count, true, 0u);
+    return maxmip_walk(uv0, v, relief_range(0.0).x, clamp(trace_params.max_steps, MAX_STEPS_MIN, MAX_STEPS_MAX));
 }

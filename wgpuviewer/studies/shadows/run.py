@@ -1,0 +1,323 @@
+"""The shadow study's measurement: suites, rows, results.csv, report.md and shadows.png.
+
+Rays: a grid of entry points over the whole map (``Suite.grid``, one ray per cell, neighbours in 8 x 4 SIMD tiles as
+pixels are) at VIEW_ANGLE from the normal. Each ray's exact first hit (``reference.exact_hit``) is shaded by a
+directional light at each elevation (azimuth LIGHT_AZIMUTH from the view's): its float64 shadow
+(``reference.shadow``) is the truth. Per technique the GPU shadow (``probe.shadow_probe``: the renderer's WGSL) is
+taken twice: at the exact hit (the shadow ray's own error) and at the technique's own view hit (``probe.probe``; what
+the renderer draws: both rays' errors). Timing (``relief.timing``): frames of a brick floor with shadows off, hard
+and soft drawn side by side, and with ``depth_offset`` off and on (two renderers, alternated round by round).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from wgpuviewer.bench.view import load_heightmap
+from wgpuviewer.core.gpu import get_gpu
+from wgpuviewer.core.io import write_bytes
+from wgpuviewer.harness import suite as harness_suite
+from wgpuviewer.harness.header import Clock, Header
+from wgpuviewer.harness.plots import MISSING, pyplot, save_png
+from wgpuviewer.harness.table import Column, Table
+from wgpuviewer.relief import reference as ref
+from wgpuviewer.relief.accuracy import simd_tile_cost
+from wgpuviewer.relief.probe import probe, shadow_probe
+from wgpuviewer.relief.renderer import Renderer
+from wgpuviewer.relief.techniques import TECHNIQUES
+from wgpuviewer.relief.timing import time_draws
+from wgpuviewer.scene import SHADOW_MODES, parse_scene
+
+TITLE = "Self-shadowing: hard and soft shadows of every ray-search technique against the float64 reference"
+VIEW_ANGLE = 45.0  # degrees from the normal, azimuth 0
+LIGHT_AZIMUTH = 150.0  # degrees from the view's azimuth: the light comes from the side, towards the viewer
+HEIGHT_SCALE = 0.08  # relief depth in uv units
+
+
+def shadowing_techniques() -> list[str]:
+    """The techniques whose ``trace`` searches along the ray: ray searches on the depth map with more than one
+    fetch (parallax offsets by one fetch: no first hit to shadow from)."""
+    return [name for name, t in TECHNIQUES.items()
+            if t.ray_search and t.needs_depth and t.fetch_bound(t.defaults()) > 1]
+
+
+@dataclass(frozen=True)
+class Suite(harness_suite.Suite):
+    heightmaps: tuple[str, ...]
+    techniques: tuple[str, ...] | None  # None: every shadowing technique
+    elevations: tuple[float, ...]
+    grid: tuple[int, int]  # rays (columns, rows) over the map
+    builtin_size: int
+    real_size: int = 0
+    timing_size: tuple[int, int] = (160, 90)  # frame of the timed draws
+    timing_frames: int = 5  # frames per draw and round
+    timing_rounds: int = 3  # rounds of the depth_offset comparison
+
+
+SUITES = harness_suite.suites(
+    Suite("smoke", ("bumps", "wall"), ("pom", "maxmip"), (30.0, 60.0), (32, 32), builtin_size=48,
+          timing_size=(64, 36), timing_frames=3, timing_rounds=1),
+    Suite("full", ("brick", "bricks", "bumps", "spike", "step", "wall", "checker"), None, (30.0, 45.0, 60.0, 80.0),
+          (96, 96), builtin_size=128, real_size=256, timing_size=(480, 270), timing_frames=20, timing_rounds=5),
+)
+
+RESULTS = Table("shadow study results", [
+    Column("heightmap", str), Column("technique", str), Column("elevation", float, "degrees"),
+    Column("rays", int, "rays with a valid reference"),
+    Column("ref_lit", float, "fraction of the rays the reference lights"),
+    Column("hard_wrong", float, "fraction with the wrong hard state, at the exact hit"),
+    Column("hard_wrong_own_hit", float, "fraction with the wrong hard state, at the technique's own view hit"),
+    Column("soft_diff", float, "mean |visibility - reference|, at the exact hit"),
+    Column("soft_diff_own_hit", float, "mean |visibility - reference|, at the technique's own view hit"),
+    Column("hard_fetches", float, "depth fetches per shadow ray"),
+    Column("hard_fetches_simd", float, "per 8x4 tile, the slowest lane's shadow-ray fetches"),
+    Column("soft_fetches", float, "depth fetches per soft estimate"),
+    Column("view_fetches", float, "depth fetches per view ray"),
+    Column("capped", float, "fraction of shadow rays flagged capped"),
+])
+
+
+TIMING = Table("shadow study timing", [
+    Column("technique", str), Column("variant", str, "shadows=MODE or depth_offset=on|off"),
+    Column("ms", float, "median ms per frame (software adapter: only ratios)"),
+    Column("ratio", float, "ms / the same technique's plain draw (shadows off, depth_offset off)"),
+])
+TIMING_TECHNIQUES = ("pom", "maxmip")
+#: The timed scene: the default scene's brick floor, seen as it sees it, with its directional light.
+TIMING_SCENE = """
+[scene]
+techniques = ["pom", "maxmip"]
+[camera]
+position = [0.0, 1.4, 3.2]
+target = [0.0, 0.0, 0.0]
+fov = 55
+[[lights]]
+type = "directional"
+direction = [-0.4, -1.0, -0.5]
+[materials.bricks]
+albedo = {{ builtin = "bricks", size = [512, 512] }}
+height = {{ builtin = "bricks", size = [512, 512] }}
+height_scale = 0.06
+uv_scale = [2.0, 2.0]
+depth_offset = {depth_offset}
+[[objects]]
+type = "plane"
+material = "bricks"
+size = [4.0, 4.0]
+"""
+
+
+def timing(gpu, suite: Suite) -> list[dict]:
+    """Frame times of the timed scene per technique: shadows off, hard, soft side by side (one renderer, round
+    robin), and depth_offset off against on (two renderers, alternated ``timing_rounds`` times; median of each)."""
+    plain = Renderer(parse_scene(TIMING_SCENE.format(depth_offset="false")), gpu)
+    offset = Renderer(parse_scene(TIMING_SCENE.format(depth_offset="true")), gpu)
+    size, frames = suite.timing_size, suite.timing_frames
+    rows = []
+    for technique in TIMING_TECHNIQUES:
+        for r in (plain, offset):
+            r.prepare(technique)
+        shadows = time_draws(plain, [plain.config(technique, shadows=m) for m in SHADOW_MODES], size, frames, 1)
+        base = shadows.results[0].median_ms
+        rows += [{"technique": technique, "variant": f"shadows={m}", "ms": t.median_ms, "ratio": t.median_ms / base}
+                 for m, t in zip(SHADOW_MODES, shadows.results)]
+        times = {False: [], True: []}
+        for _ in range(suite.timing_rounds):
+            for on, r in ((False, plain), (True, offset)):
+                times[on].append(time_draws(r, [r.config(technique)], size, frames, 1).results[0].median_ms)
+        off_ms = float(np.median(times[False]))
+        rows += [{"technique": technique, "variant": f"depth_offset={'on' if on else 'off'}",
+                  "ms": float(np.median(times[on])), "ratio": float(np.median(times[on])) / off_ms}
+                 for on in (False, True)]
+    return rows
+
+
+def rays(grid: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Entry uv (H*W, 2) at the grid's cell centres and the one view direction (3,)."""
+    w, h = grid
+    u, v = np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h)
+    return np.stack([u, v], -1).reshape(-1, 2), ref.view_dir_from_angles(VIEW_ANGLE, 0.0)
+
+
+def light(elevation: float) -> np.ndarray:
+    e, a = np.radians(elevation), np.radians(LIGHT_AZIMUTH)
+    return np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+
+
+def measure(height: np.ndarray, name: str, techniques, elevations, grid, progress=None) -> tuple[list[dict], dict]:
+    """The rows of one height map, and the masks of the first elevation for the picture (name -> (H, W) bool)."""
+    depth = 1.0 - height.astype(np.float64)
+    uv, view = rays(grid)
+    exact = ref.exact_hit(depth, uv, view, HEIGHT_SCALE)
+    ok = exact.valid
+    exact_uv = np.mod(exact.uv[ok], 1.0)
+    exact_t = exact.t[ok]
+    hits = {t: probe(t, height, uv[ok], view, HEIGHT_SCALE) for t in techniques}
+    rows, masks = [], {}
+    shape = (grid[1], grid[0])
+    for elevation in elevations:
+        direction = light(elevation)
+        truth = ref.shadow(depth, exact_uv, exact_t, direction, HEIGHT_SCALE)
+        if not masks:
+            masks["reference"] = _grid(truth.lit, ok, shape)
+        for technique in techniques:
+            hit = hits[technique]
+            at_exact = shadow_probe(technique, height, exact_uv, exact_t, direction, HEIGHT_SCALE)
+            own = shadow_probe(technique, height, np.mod(hit.uv, 1.0), hit.depth, direction, HEIGHT_SCALE)
+            if len(masks) < 1 + len(techniques):
+                masks.setdefault(technique, _grid(own.lit, ok, shape))
+            fetches = _grid(at_exact.hard_fetches.astype(np.float64), ok, shape)
+            rows.append({
+                "heightmap": name, "technique": technique, "elevation": elevation, "rays": int(ok.sum()),
+                "ref_lit": float(truth.lit.mean()),
+                "hard_wrong": float((at_exact.lit != truth.lit).mean()),
+                "hard_wrong_own_hit": float((own.lit != truth.lit).mean()),
+                "soft_diff": float(np.abs(at_exact.visibility - truth.visibility).mean()),
+                "soft_diff_own_hit": float(np.abs(own.visibility - truth.visibility).mean()),
+                "hard_fetches": float(at_exact.hard_fetches.mean()),
+                "hard_fetches_simd": simd_tile_cost(fetches, covered=_grid(np.ones(ok.sum(), bool), ok, shape)),
+                "soft_fetches": float(at_exact.soft_fetches.mean()),
+                "view_fetches": float(hit.fetches.mean()),
+                "capped": float(at_exact.capped.mean()),
+            })
+            if progress is not None:
+                progress()
+    return rows, masks
+
+
+def _grid(values: np.ndarray, ok: np.ndarray, shape) -> np.ndarray:
+    """Per-valid-ray ``values`` back on the ray grid (rays without a valid reference: 0 / False)."""
+    full = np.zeros(ok.shape, values.dtype)
+    full[ok] = values
+    return full.reshape(shape)
+
+
+def run(out: Path, suite_name: str = "full", heightmaps=None, techniques=None, elevations=None, backend=None,
+        progress: bool = True, command: str = "wgpuviewer shadows") -> list[dict]:
+    suite = harness_suite.pick(SUITES, suite_name)
+    names = tuple(heightmaps or suite.heightmaps)
+    chosen = tuple(techniques or suite.techniques or shadowing_techniques())
+    angles = tuple(elevations or suite.elevations)
+    gpu = get_gpu(backend, quiet=True)
+    clock = Clock()
+    from tqdm import tqdm
+
+    rows, pictures = [], {}
+    with tqdm(total=len(names) * len(chosen) * len(angles), desc="shadows", disable=not progress or None,
+              leave=False) as bar:
+        for name in names:
+            heightmap = load_heightmap(name, suite.builtin_size, out, suite.real_size)
+            got, masks = measure(heightmap.height, name, chosen, angles, suite.grid, lambda: bar.update(1))
+            rows += got
+            pictures[name] = masks
+    times = timing(gpu, suite)
+    RESULTS.write(out / "results.csv", rows)
+    TIMING.write(out / "timing.csv", times)
+    header = Header(TITLE, command, gpu.summary, suite.name, clock.started, clock.seconds)
+    picture = _picture(out, rows, pictures, angles[0])
+    write_bytes(out / "report.md", report(header, rows, picture, suite, times).encode("utf-8"))
+    return rows
+
+
+def report(header: Header, rows: list[dict], picture: str | None, suite: Suite, times: list[dict]) -> str:
+    lines = header.lines() + [
+        f"- rays: a {suite.grid[0]}x{suite.grid[1]} grid over each map at {VIEW_ANGLE:g} degrees from the normal; "
+        f"light azimuth {LIGHT_AZIMUTH:g} degrees from the view's; height_scale {HEIGHT_SCALE:g}",
+        f"- hard-shadow tolerance {ref.SHADOW_TOLERANCE_TEXELS:g} texel of travel; soft estimate "
+        f"{ref.SOFT_SHADOW_SAMPLES} samples, penumbra {ref.SOFT_SHADOW_PENUMBRA:g} (tangent); reference every "
+        f"{ref.SOFT_REFERENCE_STEP_TEXELS:g} texel (docs/shadows.md)",
+        "",
+        "`hard wrong`: fraction of rays whose hard shadow state differs from the float64 reference at the exact hit "
+        "(the shadow ray alone); `own hit`: the same with the shadow cast from the technique's own view hit (what "
+        "the renderer draws). `soft diff`: mean |visibility - reference| (at the exact hit the soft estimate does not "
+        "depend on the technique: its samples are plain depth reads). Fetches: depth fetches per shadow ray, "
+        "mean and SIMD-tile (per 8x4 tile of neighbouring rays, the slowest lane's). Means over maps and elevations.",
+        "",
+        "| technique | hard wrong | own hit | soft diff | own hit | hard fetches | SIMD-tile | soft fetches | "
+        "view fetches | capped |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    techniques = list(dict.fromkeys(r["technique"] for r in rows))
+    for t in techniques:
+        sel = [r for r in rows if r["technique"] == t]
+
+        def mean(key, sel=sel):
+            return float(np.mean([r[key] for r in sel]))
+
+        lines.append(f"| `{t}` | {mean('hard_wrong'):.2%} | {mean('hard_wrong_own_hit'):.2%} | "
+                     f"{mean('soft_diff'):.4f} | {mean('soft_diff_own_hit'):.4f} | {mean('hard_fetches'):.1f} | "
+                     f"{mean('hard_fetches_simd'):.1f} | {mean('soft_fetches'):.1f} | {mean('view_fetches'):.1f} | "
+                     f"{mean('capped'):.2%} |")
+    elevations = sorted({r["elevation"] for r in rows})
+    lines += ["", "Hard wrong at the exact hit / at the own hit, by light elevation (mean over maps):", "",
+              "| technique | " + " | ".join(f"{e:g}°" for e in elevations) + " |",
+              "|---|" + "---|" * len(elevations)]
+    for t in techniques:
+        cells = []
+        for e in elevations:
+            sel = [r for r in rows if r["technique"] == t and r["elevation"] == e]
+            cells.append(f"{np.mean([r['hard_wrong'] for r in sel]):.2%} / "
+                         f"{np.mean([r['hard_wrong_own_hit'] for r in sel]):.2%}")
+        lines.append(f"| `{t}` | " + " | ".join(cells) + " |")
+    maps = list(dict.fromkeys(r["heightmap"] for r in rows))
+    lines += ["", "Lit fraction of the reference per map (mean over elevations): " + ", ".join(
+        f"{m} {np.mean([r['ref_lit'] for r in rows if r['heightmap'] == m]):.0%}" for m in maps) + "."]
+    variants = [r["variant"] for r in times if r["technique"] == TIMING_TECHNIQUES[0]]
+    lines += ["", f"Frame times of the default scene's brick floor at {suite.timing_size[0]}x{suite.timing_size[1]} "
+              f"(`relief.timing`, median of {suite.timing_frames} frames; depth_offset: median of "
+              f"{suite.timing_rounds} alternated rounds), as ratios to the same technique's plain draw:", "",
+              "| technique | " + " | ".join(variants) + " |", "|---|" + "---|" * len(variants)]
+    for t in TIMING_TECHNIQUES:
+        lines.append(f"| `{t}` | " + " | ".join(f"{r['ratio']:.2f}" for r in times if r["technique"] == t) + " |")
+    lines += ["", f"![hard shadow errors and costs]({picture})" if picture else MISSING, ""]
+    return "\n".join(lines)
+
+
+def _picture(out: Path, rows: list[dict], pictures: dict, elevation: float) -> str | None:
+    """shadows.png: hard-shadow errors by elevation, fetches per technique, and the first map's hard shadows at the
+    first elevation: the reference's, and those of the technique with the most wrong rays there and the one with the
+    fewest (wrong rays in red)."""
+    with pyplot() as plt:
+        if plt is None:
+            return None
+        techniques = list(dict.fromkeys(r["technique"] for r in rows))
+        first = next(iter(pictures))
+        masks = pictures[first]
+        fig = plt.figure(figsize=(13, 9))
+        grid = fig.add_gridspec(2, 6, hspace=0.45, wspace=0.6)
+        errors = fig.add_subplot(grid[0, :3])
+        costs = fig.add_subplot(grid[0, 3:])
+        elevations = sorted({r["elevation"] for r in rows})
+        colors = plt.get_cmap("tab20").colors
+        for i, t in enumerate(techniques):
+            errors.plot(elevations, [100 * np.mean([r["hard_wrong_own_hit"] for r in rows
+                                                    if r["technique"] == t and r["elevation"] == e])
+                                     for e in elevations], marker="os^v"[i % 4], color=colors[i % 20], label=t)
+        errors.set_xlabel("light elevation (degrees)")
+        errors.set_ylabel("wrong hard shadow, own hit (% of rays)")
+        errors.grid(True)
+        errors.legend(fontsize=7, ncol=2)
+        x = np.arange(len(techniques))
+        for offset, key, label in ((-0.2, "hard_fetches", "mean"), (0.2, "hard_fetches_simd", "SIMD-tile")):
+            costs.bar(x + offset, [np.mean([r[key] for r in rows if r["technique"] == t]) for t in techniques],
+                      0.4, label=label)
+        costs.set_xticks(x, techniques, rotation=45, ha="right", fontsize=7)
+        costs.set_ylabel("depth fetches per hard shadow ray")
+        costs.grid(True, axis="y")
+        costs.legend(fontsize=7)
+        here = {r["technique"]: r["hard_wrong_own_hit"] for r in rows
+                if r["heightmap"] == first and r["elevation"] == elevation}
+        ranked = sorted(here, key=here.get)
+        truth = masks["reference"]
+        for i, label in enumerate(("reference", ranked[-1], ranked[0])):
+            ax = fig.add_subplot(grid[1, 2 * i: 2 * i + 2])
+            picture = np.repeat(masks[label][..., None].astype(np.float64), 3, axis=2)
+            picture[masks[label] != truth] = (1.0, 0.0, 0.0)
+            ax.imshow(picture, interpolation="nearest", aspect=truth.shape[1] / truth.shape[0])
+            wrong = "" if label == "reference" else f", {here[label]:.1%} wrong"
+            ax.set_title(f"{first}, light at {elevation:g}°: {label}{wrong}", fontsize=8)
+            ax.axis("off")
+        return save_png(fig, out / "shadows.png")
