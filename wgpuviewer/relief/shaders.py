@@ -8,7 +8,7 @@ visibility snippet for the texel-loop filters) + for rendering a derivative sour
 shading-normal snippet + an entry-point file (``entry/render.wgsl``, ``entry/probe.wgsl`` or
 ``entry/filter_probe.wgsl``), composed by ``wgpuviewer.core.wgsl`` (includes, line map for error locations).
 Only the draw's filter and derivative source are compiled. A render module is also one material variant
-(``MaterialVariant``): its shadow snippet (``common/shadow_off|hard|soft.wgsl``: only a shadowing variant compiles
+(``MaterialVariant``): its shadow snippet (``shadows/off|hard|soft.wgsl``: only a shadowing variant compiles
 shadow code) and its addressing (``RELIEF_CLAMP``); the shadow constants come from the float64 reference
 (``reference.SHADOW_TOLERANCE_TEXELS`` ...), so both test one definition.
 """
@@ -131,7 +131,7 @@ def compose_technique(technique: Technique, entry: str, filter: str = DEFAULT_FI
         parts.append("shading/normal_from_map.wgsl" if "normal" in technique.textures else "shading/normal_flat.wgsl")
         if variant.shadows != "off" and not traces_relief(technique):
             raise ValueError(f"technique {technique.name!r} does not trace the relief: no shadows to draw")
-        parts += [f"common/shadow_{variant.shadows}.wgsl",
+        parts += [f"shadows/{variant.shadows}.wgsl",
                   Generated("<generated: material variant>", f"const RELIEF_CLAMP: bool = {str(variant.clamp).lower()};\n")]
     parts += [*records, f"entry/{entry}.wgsl"]
     return compose(*parts)

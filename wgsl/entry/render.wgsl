@@ -2,7 +2,7 @@
 // filter's lookups at the hit and the thesis' shading model (ambient 0.2 * albedo, Lambert diffuse,
 // Blinn-Phong 0.2 * pow(., 32)). Composed after the generated interfaces (MAX_LIGHTS among them), one technique
 // file, one filter (`filter_texture`), one derivative source (`texture_derivatives`) and one shading_normal
-// snippet, one shadow snippet (`light_visibility`, common/shadow_MODE.wgsl) and the material variant's constants
+// snippet, one shadow snippet (`light_visibility`, shadows/MODE.wgsl) and the material variant's constants
 // (RELIEF_CLAMP) (wgpuviewer/relief/shaders.py). The Frame, Light and Object structs are generated from shaders.FRAME
 // and shaders.OBJECT; DataOut and DataOutHitDepth from renderer.DATA_OUT.
 // #include "common/heat.wgsl"
