@@ -107,3 +107,17 @@ def test_help_defines_the_view_angle(capsys):
         assert option in text
     assert "at DEG degrees from the surface normal: 0 looks straight down onto it" in text
     assert "the scene's first plane (where --material shows its folder)" in text
+
+
+def test_view_angle_needs_a_subject_with_one_normal(tmp_path, capsys):
+    """A sphere subject has no single normal to measure a view angle from: one line, exit 2, naming the fix."""
+    path = tmp_path / "sphere.toml"
+    material = 'albedo = { builtin = "bumps", size = [32, 32] }\nheight = { builtin = "bumps", size = [32, 32] }'
+    text = material_scene(["basic"], material).replace('type = "plane"', 'type = "sphere"').replace(
+        "size = [2.0, 2.0]", "size = [0.5]")
+    path.write_text(text)
+    out = tmp_path / "x.png"
+    assert cli.main(["render", str(path), "-o", str(out), "--size", "8x8", "--view-angle", "40"]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and "--view-angle 40" in lines[0] and "is a sphere" in lines[0] and "--camera" in lines[0]
+    assert not out.exists()

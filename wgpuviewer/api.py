@@ -157,6 +157,11 @@ def camera_for(scene: Scene, spec: CameraSpec | dict | None = None, names: dict 
     fov = _number(names, "fov", spec.fov, 1, 179, True, True) if spec.fov is not None else base.fov
     if spec.view_angle is not None:
         angle = math.radians(_number(names, "view_angle", spec.view_angle, 0, 90, False, True))
+        kind = scene.objects[subject(scene)].kind
+        if kind not in SURFACE_NORMALS:  # a curved or mesh subject has no one normal to measure the angle from
+            raise InputError(f"{_label(names, 'view_angle', spec.view_angle)}: the scene's subject (its first "
+                             f"plane, else its first object) is a {kind}, which has no single surface normal; "
+                             f"expected a subject of type {', '.join(SURFACE_NORMALS)}, or give {names['position']}")
         normal = surface_normal(scene)
         seen_from = np.asarray(base.position) - target
         distance = float(np.linalg.norm(seen_from))
