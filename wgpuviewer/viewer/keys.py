@@ -1,5 +1,5 @@
 """The viewer's controls, in one table: what the keys (and the mouse) do. ``Viewer.press`` dispatches on it, the
-help panel (F1) lists it, ``--keys`` checks against it, and the README's keys table is generated from it
+help panel (F1) lists it, ``--keys`` checks against it, and the keys table of docs/usage.md is generated from it
 (``markdown_table``; a test compares the two).
 
 Key names are rendercanvas's event keys: Shift+D arrives as "D", so "d" (strafe, held) and "D" (cost view) are
@@ -30,7 +30,7 @@ def technique_key(name: str) -> str:
 
 @dataclass(frozen=True)
 class Control:
-    label: str  # as the help panel and the README show it
+    label: str  # as the help panel and docs/usage.md show it
     help: str
     keys: tuple[str, ...] = ()  # event keys that trigger it; () for mouse controls
     action: str = ""  # the Viewer method called with the key pressed ("" for held and mouse controls)
@@ -78,7 +78,7 @@ PRESSED = {key: control for control in CONTROLS if control.action for key in con
 
 
 def markdown_table() -> str:
-    """The README's keys table."""
+    """The keys table of docs/usage.md."""
     rows = ["| key | action |", "|---|---|"]
     rows += [f"| {c.label} | {c.help} |" for c in CONTROLS]
     return "\n".join(rows)
