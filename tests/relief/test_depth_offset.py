@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wgpuviewer.relief.renderer import Renderer
+from wgpuviewer.relief.renderer import DrawConfig, Renderer
 from wgpuviewer.scene import parse_scene
 
 SIZE = (96, 96)
@@ -75,3 +75,17 @@ def test_a_sunk_box_shows_where_the_relief_is_lower_than_its_top(gpu, tmp_path):
     # without depth_offset the floor's polygon (at the surface) hides the whole box
     plain = Renderer(parse_scene(scene(tmp_path, False)), gpu).render("maxmip", SIZE)
     assert not is_green(plain).any()
+
+
+@pytest.mark.requires_gpu
+def test_the_draw_overrides_each_materials_depth_offset(gpu, tmp_path):
+    """DrawConfig.depth_offset (the viewer's Z) turns the hit's depth on for a material without it, and off for one
+    with it: the same pictures as the materials' own settings."""
+    own_on = Renderer(parse_scene(scene(tmp_path, True)), gpu).render("maxmip", SIZE)
+    own_off = Renderer(parse_scene(scene(tmp_path, False)), gpu)
+    forced_on = own_off.render(DrawConfig.of("maxmip", depth_offset=True), SIZE)
+    assert is_green(forced_on).mean() > 0.05
+    assert np.array_equal(forced_on.color, own_on.color)
+    forced_off = Renderer(parse_scene(scene(tmp_path, True)), gpu).render(DrawConfig.of("maxmip", depth_offset=False),
+                                                                          SIZE)
+    assert not is_green(forced_off).any()

@@ -1,5 +1,5 @@
 """The self-shadowing key (L): the state's override cycles the materials' own, off, hard, soft; the draws get it;
-in a window it darkens the relief where the lights are hidden."""
+in a window it darkens the relief where the lights are hidden. The depth-offset key (Z) cycles its override alike."""
 
 from __future__ import annotations
 
@@ -46,3 +46,11 @@ def test_the_shadow_key_darkens_the_relief_in_the_window(display, adapter, tmp_p
     hard = screenshot(display, tmp_path, "H,5,L,L")  # materials' own (off) -> off -> hard
     assert (hard <= plain + 2).all()
     assert ((plain - hard).max(axis=2) > 16).mean() > 0.005
+
+
+def test_z_cycles_the_depth_offset_override_for_both_halves():
+    state = ViewerState.start(["pom"], "pom", DEFAULT_FILTER, DEFAULT_DERIVATIVES)
+    assert state.depth_offset is None and state.depth_offset_label == "materials"
+    assert PRESSED["z"].action == PRESSED["Z"].action == "cycle_depth_offset"
+    seen = [(state.cycle_depth_offset(), state.depth_offset_label) for _ in range(3)]
+    assert seen == [(False, "off"), (True, "on"), (None, "materials")]

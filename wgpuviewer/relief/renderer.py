@@ -117,18 +117,23 @@ class DrawConfig:
     #: Self-shadowing for every material (scene.SHADOW_MODES), overriding each material's ``shadows``; None: each
     #: material's own.
     shadows: str | None = None
+    #: Depth offset for every material, overriding each material's ``depth_offset``; None: each material's own.
+    depth_offset: bool | None = None
 
     @classmethod
     def of(cls, technique: str, params: dict | None = None, height_scale: float | None = None, *,
            filter: str = DEFAULT_FILTER, filter_params: dict | None = None,
-           derivatives: str = DEFAULT_DERIVATIVES, shadows: str | None = None) -> DrawConfig:
+           derivatives: str = DEFAULT_DERIVATIVES, shadows: str | None = None,
+           depth_offset: bool | None = None) -> DrawConfig:
         t = get_technique(technique)
         f = get_filter(filter)
         if shadows is not None and shadows not in SHADOW_MODES:
             raise UserError(f"shadows = {shadows!r}; expected one of {', '.join(SHADOW_MODES)}")
+        if depth_offset not in (None, True, False):
+            raise UserError(f"depth_offset = {depth_offset!r}; expected true, false or none (each material's own)")
         return cls(t.name, tuple(resolve_params(t, params).items()), height_scale, f.name,
                    tuple(resolve_filter_params(f, filter_params).items()), get_derivatives(derivatives).name,
-                   shadows)
+                   shadows, depth_offset)
 
     @property
     def values(self) -> dict:
@@ -392,12 +397,13 @@ class Renderer:
                                  records=(DATA_OUT.generated(), hit_depth_outputs(DATA_OUT)), variant=variant)
 
     def variant(self, material_name: str, technique: Technique, draw: DrawConfig) -> MaterialVariant:
-        """The material variant a material is drawn with: its ``shadows`` (the draw's override first),
-        ``depth_offset`` and ``address``; shadows and the hit's depth only where the technique traces the relief."""
+        """The material variant a material is drawn with: its ``shadows`` and ``depth_offset`` (the draw's overrides
+        first) and ``address``; shadows and the hit's depth only where the technique traces the relief."""
         material = self.scene.materials[material_name]
         traced = traces_relief(technique)
         shadows = material.shadows if draw.shadows is None else draw.shadows
-        return MaterialVariant(shadows if traced else "off", material.depth_offset and traced,
+        depth_offset = material.depth_offset if draw.depth_offset is None else draw.depth_offset
+        return MaterialVariant(shadows if traced else "off", depth_offset and traced,
                                material.address == "clamp")
 
     def pipeline(self, technique: Technique, formats: tuple[str, ...], filter: str = DEFAULT_FILTER,

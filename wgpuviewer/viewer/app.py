@@ -236,11 +236,11 @@ class Viewer:
 
     def draw_config(self, half: Half) -> DrawConfig:
         """What a pass of ``half`` draws: its technique's live parameters and height-scale override, its filter with
-        its live parameters and its derivative source, and the self-shadowing override (L)."""
+        its live parameters and its derivative source, and the self-shadowing (L) and depth-offset (Z) overrides."""
         name = half.technique
         return DrawConfig.of(name, self.technique_params(name), self.height_scales.get(name), filter=half.filter,
                              filter_params=self.filter_params[half.filter], derivatives=half.derivatives,
-                             shadows=self.state.shadows)
+                             shadows=self.state.shadows, depth_offset=self.state.depth_offset)
 
     def cost_scale(self, side: str = "A") -> float:
         """The fetch count the cost view paints as full heat on half ``side``."""
@@ -283,6 +283,10 @@ class Viewer:
     def cycle_shadows(self, key: str):
         self.state.cycle_shadows()
         self.message(f"shadows: {self.state.shadows_label}")
+
+    def cycle_depth_offset(self, key: str):
+        self.state.cycle_depth_offset()
+        self.message(f"depth offset: {self.state.depth_offset_label}")
 
     def cycle_derivatives(self, key: str):
         half = self.state.cycle_derivatives()

@@ -280,7 +280,7 @@ class Hud:
                 imgui.text(heading)
             self._half(half, tag)
             imgui.separator()
-        imgui.text(f"shadows (L): {state.shadows_label}")
+        imgui.text(f"shadows (L): {state.shadows_label}   depth offset (Z): {state.depth_offset_label}")
         for i, mode in enumerate(("color", "cost", "error")):
             if i:
                 imgui.same_line()

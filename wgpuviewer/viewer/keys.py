@@ -59,6 +59,8 @@ CONTROLS = (
             "cycle_derivatives"),
     Control("L", "self-shadowing: the materials' own, then off, hard, soft for every material; the HUD names it",
             ("l", "L"), "cycle_shadows"),
+    Control("Z", "depth offset (the traced hit's depth): the materials' own, then off, on for every material; the HUD "
+            "names it", ("z", "Z"), "cycle_depth_offset"),
     Control("B", "A/B split between two techniques or filters; drag the divider", ("b", "B"), "toggle_split"),
     Control("Tab", "the half of the A/B split the keys change", ("Tab",), "switch_half"),
     Control("P", "save a screenshot PNG (scene only) in the current directory", ("p", "P"), "request_screenshot"),

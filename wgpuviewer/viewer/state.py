@@ -1,6 +1,6 @@
 """What the viewer shows, without a window or a GPU: the scene's techniques, the two halves of the A/B split (each a
 ``Half``: technique, texture filter, derivative source), which half the keys change, the divider, and the
-self-shadowing override (both halves: ``shadows``).
+self-shadowing and depth-offset overrides (both halves: ``shadows``, ``depth_offset``).
 
 The key actions that only change this state are transitions here, so tests drive them directly; whatever needs maps
 built or a window (switching to a technique whose maps are missing, vsync, fullscreen) stays in the app.
@@ -18,6 +18,8 @@ from .keys import TECHNIQUE_KEYS, technique_key
 SIDES = ("A", "B")
 #: What L steps through: None (each material's own ``shadows``), then every mode for all materials.
 SHADOW_CHOICES = (None, *SHADOW_MODES)
+#: What Z steps through: None (each material's own ``depth_offset``), then off and on for all materials.
+DEPTH_OFFSET_CHOICES = (None, False, True)
 
 
 @dataclass
@@ -41,6 +43,7 @@ class ViewerState:
     active_side: str = "A"
     split_x: float = 0.5  # the divider, as a fraction of the width
     shadows: str | None = None  # self-shadowing for every material (scene.SHADOW_MODES); None: each material's own
+    depth_offset: bool | None = None  # the hit's depth written for every material (or not); None: each material's own
 
     @classmethod
     def start(cls, techniques, technique: str, filter: str, derivatives: str) -> ViewerState:
@@ -113,6 +116,17 @@ class ViewerState:
     def shadows_label(self) -> str:
         """How the HUD names the override: 'materials' (each its own), or the mode for all."""
         return "materials" if self.shadows is None else self.shadows
+
+    def cycle_depth_offset(self) -> bool | None:
+        """The next depth-offset override (DEPTH_OFFSET_CHOICES); returns it."""
+        i = DEPTH_OFFSET_CHOICES.index(self.depth_offset)
+        self.depth_offset = DEPTH_OFFSET_CHOICES[(i + 1) % len(DEPTH_OFFSET_CHOICES)]
+        return self.depth_offset
+
+    @property
+    def depth_offset_label(self) -> str:
+        """How the HUD names the override: 'materials' (each its own), 'off' or 'on' for all."""
+        return "materials" if self.depth_offset is None else ("on" if self.depth_offset else "off")
 
     def toggle_split(self) -> None:
         """Split or join the screen; either way the keys change half A next."""
