@@ -477,7 +477,7 @@ class Renderer:
     def config(self, technique: str, params: dict | None = None, height_scale: float | None = None,
                **filtering) -> DrawConfig:
         """A DrawConfig for ``technique`` starting from the scene's parameters for it, ``params`` overriding;
-        ``filtering``: DrawConfig.of's filter, filter_params and derivatives."""
+        ``filtering``: DrawConfig.of's filter, filter_params, derivatives, shadows and depth_offset."""
         name = get_technique(technique).name
         return DrawConfig.of(name, {**self.scene.technique_params.get(name, {}), **(params or {})}, height_scale,
                              **filtering)

@@ -5,8 +5,9 @@ pixels are) at VIEW_ANGLE from the normal. Each ray's exact first hit (``referen
 directional light at each elevation (azimuth LIGHT_AZIMUTH from the view's): its float64 shadow
 (``reference.shadow``) is the truth. Per technique the GPU shadow (``probe.shadow_probe``: the renderer's WGSL) is
 taken twice: at the exact hit (the shadow ray's own error) and at the technique's own view hit (``probe.probe``; what
-the renderer draws: both rays' errors). Timing (``relief.timing``): frames of a brick floor with shadows off, hard
-and soft drawn side by side, and with ``depth_offset`` off and on (two renderers, alternated round by round).
+the renderer draws: both rays' errors). Timing (``relief.timing``): frames of a brick floor, open and half hidden
+behind a wall drawn first, with shadows off, hard, soft and ``depth_offset`` on drawn side by side (the draw's
+overrides, round robin).
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from wgpuviewer.relief.probe import probe, shadow_probe
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.relief.techniques import TECHNIQUES
 from wgpuviewer.relief.timing import time_draws
-from wgpuviewer.scene import SHADOW_MODES, parse_scene
+from wgpuviewer.scene import parse_scene
 
 TITLE = "Self-shadowing: hard and soft shadows of every ray-search technique against the float64 reference"
 VIEW_ANGLE = 45.0  # degrees from the normal, azimuth 0
@@ -53,15 +54,14 @@ class Suite(harness_suite.Suite):
     builtin_size: int
     real_size: int = 0
     timing_size: tuple[int, int] = (160, 90)  # frame of the timed draws
-    timing_frames: int = 5  # frames per draw and round
-    timing_rounds: int = 3  # rounds of the depth_offset comparison
+    timing_frames: int = 5  # frames per draw
 
 
 SUITES = harness_suite.suites(
     Suite("smoke", ("bumps", "wall"), ("pom", "maxmip"), (30.0, 60.0), (32, 32), builtin_size=48,
-          timing_size=(64, 36), timing_frames=3, timing_rounds=1),
+          timing_size=(64, 36), timing_frames=3),
     Suite("full", ("brick", "bricks", "bumps", "spike", "step", "wall", "checker"), None, (30.0, 45.0, 60.0, 80.0),
-          (96, 96), builtin_size=128, real_size=256, timing_size=(480, 270), timing_frames=20, timing_rounds=5),
+          (96, 96), builtin_size=128, real_size=256, timing_size=(480, 270), timing_frames=20),
 )
 
 RESULTS = Table("shadow study results", [
@@ -81,12 +81,18 @@ RESULTS = Table("shadow study results", [
 
 
 TIMING = Table("shadow study timing", [
-    Column("technique", str), Column("variant", str, "shadows=MODE or depth_offset=on|off"),
+    Column("scene", str, "open: the floor alone; occluded: a wall drawn first hides part of it"),
+    Column("technique", str), Column("variant", str, "plain, shadows=hard|soft or depth_offset=on"),
     Column("ms", float, "median ms per frame (software adapter: only ratios)"),
-    Column("ratio", float, "ms / the same technique's plain draw (shadows off, depth_offset off)"),
+    Column("ratio", float, "ms / the same scene and technique's plain draw (shadows off, depth_offset off)"),
+    Column("hidden", float, "fraction of the floor's pixels behind the wall (the fragments early depth testing skips)"),
 ])
 TIMING_TECHNIQUES = ("pom", "maxmip")
-#: The timed scene: the default scene's brick floor, seen as it sees it, with its directional light.
+#: The timed variants: the draw's overrides (shadows, depth_offset) on a material that has neither.
+TIMING_VARIANTS = {"plain": {}, "shadows=hard": {"shadows": "hard"}, "shadows=soft": {"shadows": "soft"},
+                   "depth_offset=on": {"depth_offset": True}}
+#: The timed scene: the default scene's brick floor (FLOOR), seen as it sees it, with its directional light; in the
+#: occluded scene a wall (OCCLUDER) is listed, so drawn, before the floor, standing between it and the camera.
 TIMING_SCENE = """
 [scene]
 techniques = ["pom", "maxmip"]
@@ -102,37 +108,44 @@ albedo = {{ builtin = "bricks", size = [512, 512] }}
 height = {{ builtin = "bricks", size = [512, 512] }}
 height_scale = 0.06
 uv_scale = [2.0, 2.0]
-depth_offset = {depth_offset}
-[[objects]]
+[materials.grey]
+albedo = [0.5, 0.5, 0.5]
+{objects}
+"""
+FLOOR = """[[objects]]
 type = "plane"
 material = "bricks"
-size = [4.0, 4.0]
-"""
+size = [4.0, 4.0]"""
+OCCLUDER = """[[objects]]
+type = "box"
+material = "grey"
+size = [4.0, 1.2, 0.1]
+position = [0.0, 0.6, 1.0]"""
 
 
 def timing(gpu, suite: Suite) -> list[dict]:
-    """Frame times of the timed scene per technique: shadows off, hard, soft side by side (one renderer, round
-    robin), and depth_offset off against on (two renderers, alternated ``timing_rounds`` times; median of each)."""
-    plain = Renderer(parse_scene(TIMING_SCENE.format(depth_offset="false")), gpu)
-    offset = Renderer(parse_scene(TIMING_SCENE.format(depth_offset="true")), gpu)
-    size, frames = suite.timing_size, suite.timing_frames
+    """Frame times per scene (open, occluded) and technique of every TIMING_VARIANTS draw, round robin in one renderer
+    (``relief.timing``), as ratios to the plain draw. Writing the hit's depth (depth_offset) turns off early depth
+    testing: behind the wall the floor's fragments then run their whole search before the depth test drops them."""
     rows = []
-    for technique in TIMING_TECHNIQUES:
-        for r in (plain, offset):
-            r.prepare(technique)
-        shadows = time_draws(plain, [plain.config(technique, shadows=m) for m in SHADOW_MODES], size, frames, 1)
-        base = shadows.results[0].median_ms
-        rows += [{"technique": technique, "variant": f"shadows={m}", "ms": t.median_ms, "ratio": t.median_ms / base}
-                 for m, t in zip(SHADOW_MODES, shadows.results)]
-        times = {False: [], True: []}
-        for _ in range(suite.timing_rounds):
-            for on, r in ((False, plain), (True, offset)):
-                times[on].append(time_draws(r, [r.config(technique)], size, frames, 1).results[0].median_ms)
-        off_ms = float(np.median(times[False]))
-        rows += [{"technique": technique, "variant": f"depth_offset={'on' if on else 'off'}",
-                  "ms": float(np.median(times[on])), "ratio": float(np.median(times[on])) / off_ms}
-                 for on in (False, True)]
+    for scene_name, objects in (("open", FLOOR), ("occluded", OCCLUDER + "\n" + FLOOR)):
+        renderer = Renderer(parse_scene(TIMING_SCENE.format(objects=objects)), gpu)
+        hidden = _hidden_share(gpu, suite.timing_size) if scene_name == "occluded" else 0.0
+        for technique in TIMING_TECHNIQUES:
+            draws = [renderer.config(technique, **overrides) for overrides in TIMING_VARIANTS.values()]
+            results = time_draws(renderer, draws, suite.timing_size, suite.timing_frames, 1).results
+            base = results[0].median_ms
+            rows += [{"scene": scene_name, "technique": technique, "variant": variant, "ms": t.median_ms,
+                      "ratio": t.median_ms / base, "hidden": hidden}
+                     for variant, t in zip(TIMING_VARIANTS, results)]
     return rows
+
+
+def _hidden_share(gpu, size: tuple[int, int]) -> float:
+    """The fraction of the floor's covered pixels that the wall covers (each rendered alone, basic)."""
+    floor, wall = (Renderer(parse_scene(TIMING_SCENE.format(objects=o)), gpu).render("basic", size).covered
+                   for o in (FLOOR, OCCLUDER))
+    return float((floor & wall).sum() / max(floor.sum(), 1))
 
 
 def rays(grid: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
@@ -265,13 +278,16 @@ def report(header: Header, rows: list[dict], picture: str | None, suite: Suite, 
     maps = list(dict.fromkeys(r["heightmap"] for r in rows))
     lines += ["", "Lit fraction of the reference per map (mean over elevations): " + ", ".join(
         f"{m} {np.mean([r['ref_lit'] for r in rows if r['heightmap'] == m]):.0%}" for m in maps) + "."]
-    variants = [r["variant"] for r in times if r["technique"] == TIMING_TECHNIQUES[0]]
+    hidden = max(r["hidden"] for r in times)
     lines += ["", f"Frame times of the default scene's brick floor at {suite.timing_size[0]}x{suite.timing_size[1]} "
-              f"(`relief.timing`, median of {suite.timing_frames} frames; depth_offset: median of "
-              f"{suite.timing_rounds} alternated rounds), as ratios to the same technique's plain draw:", "",
-              "| technique | " + " | ".join(variants) + " |", "|---|" + "---|" * len(variants)]
-    for t in TIMING_TECHNIQUES:
-        lines.append(f"| `{t}` | " + " | ".join(f"{r['ratio']:.2f}" for r in times if r["technique"] == t) + " |")
+              f"(`relief.timing`, median of {suite.timing_frames} frames, the variants drawn round robin), open and "
+              f"with a wall drawn first that hides {hidden:.0%} of it, as ratios to the same scene and technique's "
+              "plain draw:", "",
+              "| scene | technique | " + " | ".join(TIMING_VARIANTS) + " |", "|---|---|" + "---|" * len(TIMING_VARIANTS)]
+    for scene_name in dict.fromkeys(r["scene"] for r in times):
+        for t in TIMING_TECHNIQUES:
+            cells = [f"{r['ratio']:.2f}" for r in times if r["technique"] == t and r["scene"] == scene_name]
+            lines.append(f"| {scene_name} | `{t}` | " + " | ".join(cells) + " |")
     lines += ["", f"![hard shadow errors and costs]({picture})" if picture else MISSING, ""]
     return "\n".join(lines)
 
