@@ -264,7 +264,16 @@ def cmd_accuracy(args) -> int:
     from tqdm import tqdm
 
     from wgpuviewer.core.io import write_bytes
-    from wgpuviewer.relief.accuracy import DEFAULT_ANGLES, DEFAULT_SETTINGS, markdown_report, run, table
+    from wgpuviewer.relief.accuracy import (
+        DEFAULT_ANGLES,
+        DEFAULT_SETTINGS,
+        SHADOW_ELEVATIONS,
+        markdown_report,
+        run,
+        shadow_run,
+        shadowing_techniques,
+        table,
+    )
 
     from .textures import BUILTINS, builtin_height
 
@@ -273,6 +282,8 @@ def cmd_accuracy(args) -> int:
             raise UserError(f"--heightmaps: unknown builtin {name!r}; expected some of {', '.join(BUILTINS)}")
     maps = {name: builtin_height(name, (args.texels, args.texels)) for name in args.heightmaps}
     total = len(maps) * len(DEFAULT_SETTINGS) * len(DEFAULT_ANGLES)
+    if args.doc:  # the report adds every shadowing technique's self-shadowing at each light elevation
+        total += len(maps) * len(shadowing_techniques()) * len(SHADOW_ELEVATIONS)
     from wgpuviewer.core.gpu import get_gpu
 
     gpu = get_gpu(args.backend)
@@ -280,11 +291,13 @@ def cmd_accuracy(args) -> int:
         if args.doc:
             measured = run(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend,
                            progress=bar.update)
+            shadows = shadow_run(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend,
+                                 progress=bar.update)
         else:
             text = table(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend,
                          progress=bar.update)
     if args.doc:
-        report = markdown_report(measured, command=args.command_line, adapter=gpu.summary)
+        report = markdown_report(measured, command=args.command_line, adapter=gpu.summary, shadows=shadows)
         write_bytes(args.doc, report.encode("utf-8"))
         print(args.doc)
         return 0

@@ -6,7 +6,15 @@ import numpy as np
 import pytest
 
 from wgpuviewer.core.errors import InputError
-from wgpuviewer.relief.accuracy import DEFAULT_SETTINGS, markdown_report, measure, run, simd_tile_cost
+from wgpuviewer.relief.accuracy import (
+    DEFAULT_SETTINGS,
+    markdown_report,
+    measure,
+    run,
+    shadow_report,
+    shadow_run,
+    simd_tile_cost,
+)
 from wgpuviewer.relief.techniques import TECHNIQUES
 from wgpuviewer.textures import builtin_height
 
@@ -105,3 +113,30 @@ def test_measure_refuses_what_it_cannot_use_in_one_line_before_tracing(kwargs, m
 def test_measure_at_its_largest_angle_and_ray_counts_gives_numbers(gpu):
     a = measure("pom", np.full((8, 8), 0.5), 89.9, rays=1)
     assert a.rays == 1 and np.isfinite(a.fetches_mean)
+
+
+def test_shadow_report_of_a_tiny_run(gpu):
+    """The report's self-shadowing table: a row per technique, a column per light; each cell the mean over the maps
+    of the wrong hard states from the technique's own hits (the worst map in brackets), the soft difference and the
+    shadow ray's fetches, as the run measured them. The exact tracer casts the reference's shadows."""
+    maps = {"step": builtin_height("step", (16, 16)), "bricks": builtin_height("bricks", (32, 32))}
+    measured = shadow_run(maps, techniques=("pom", "maxmip"), elevations=(30.0, 60.0), rays=256)
+    lines = shadow_report(measured)
+    assert "## Self-shadowing" in lines
+    header = lines.index("| technique | light 30° | light 60° |")
+    for row, technique in zip(lines[header + 2:], ("pom", "maxmip"), strict=True):
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert cells[0] == technique
+        for cell, elevation in zip(cells[1:], (30.0, 60.0), strict=True):
+            sel = [measured.results[name, technique, elevation] for name in maps]
+            wrong = [100 * m.hard_wrong_own_hit for m in sel]
+            expected = (f"{np.mean(wrong):.2f} % ({max(wrong):.2f}) / "
+                        f"{np.mean([m.soft_diff_own_hit for m in sel]):.4f} · "
+                        f"{np.mean([m.hard_fetches.mean() for m in sel]):.1f}")
+            assert cell == expected
+    lit = [m.ref_lit for m in measured.results.values() if m.elevation == 30.0]
+    assert min(lit) < 1.0  # shadows to get right
+    assert all(m.hard_wrong <= 0.02 for (_, t, _), m in measured.results.items() if t == "maxmip")
+    text = markdown_report(run(maps, angles=(0.0,), settings=(("pom", {}),), rays=8), "c", "Test GPU",
+                           "2026-01-02", shadows=measured)
+    assert text.rstrip().endswith(lines[-1]) and "(self-shadowing" in text.splitlines()[4]

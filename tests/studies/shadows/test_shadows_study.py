@@ -6,7 +6,8 @@ import pytest
 
 from wgpuviewer.cli import main
 from wgpuviewer.harness.study import discover
-from wgpuviewer.studies.shadows.run import RESULTS, shadowing_techniques
+from wgpuviewer.relief.accuracy import shadowing_techniques
+from wgpuviewer.studies.shadows.run import RESULTS
 
 
 def test_the_study_is_a_command_and_casts_shadows_only_with_searching_techniques():

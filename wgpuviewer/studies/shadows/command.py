@@ -26,9 +26,8 @@ class Shadows:
     def options(self, args) -> dict:
         """``run.run``'s keyword arguments, each option checked."""
         from wgpuviewer.bench.run import check_heightmaps
+        from wgpuviewer.relief.accuracy import shadowing_techniques
         from wgpuviewer.relief.techniques import get_technique
-
-        from .run import shadowing_techniques
 
         elevations = comma_numbers(args.elevations, "--elevations", "30,80")
         if elevations is not None and not all(0.0 < e <= 90.0 for e in elevations):

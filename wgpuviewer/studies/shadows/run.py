@@ -25,24 +25,14 @@ from wgpuviewer.harness.header import Clock, Header
 from wgpuviewer.harness.plots import MISSING, pyplot, save_png
 from wgpuviewer.harness.table import Column, Table
 from wgpuviewer.relief import reference as ref
-from wgpuviewer.relief.accuracy import simd_tile_cost
-from wgpuviewer.relief.probe import probe, shadow_probe
+from wgpuviewer.relief.accuracy import LIGHT_AZIMUTH, measure_shadows, shadowing_techniques, simd_tile_cost
 from wgpuviewer.relief.renderer import Renderer
-from wgpuviewer.relief.techniques import TECHNIQUES
 from wgpuviewer.relief.timing import time_draws
 from wgpuviewer.scene import parse_scene
 
 TITLE = "Self-shadowing: hard and soft shadows of every ray-search technique against the float64 reference"
-VIEW_ANGLE = 45.0  # degrees from the normal, azimuth 0
-LIGHT_AZIMUTH = 150.0  # degrees from the view's azimuth: the light comes from the side, towards the viewer
+VIEW_ANGLE = 45.0  # degrees from the normal, azimuth 0 (lights at accuracy.LIGHT_AZIMUTH: from the side, towards it)
 HEIGHT_SCALE = 0.08  # relief depth in uv units
-
-
-def shadowing_techniques() -> list[str]:
-    """The techniques whose ``trace`` searches along the ray: ray searches on the depth map with more than one
-    fetch (parallax offsets by one fetch: no first hit to shadow from)."""
-    return [name for name, t in TECHNIQUES.items()
-            if t.ray_search and t.needs_depth and t.fetch_bound(t.defaults()) > 1]
 
 
 @dataclass(frozen=True)
@@ -155,49 +145,22 @@ def rays(grid: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([u, v], -1).reshape(-1, 2), ref.view_dir_from_angles(VIEW_ANGLE, 0.0)
 
 
-def light(elevation: float) -> np.ndarray:
-    e, a = np.radians(elevation), np.radians(LIGHT_AZIMUTH)
-    return np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
-
-
 def measure(height: np.ndarray, name: str, techniques, elevations, grid, progress=None) -> tuple[list[dict], dict]:
     """The rows of one height map, and the masks of the first elevation for the picture (name -> (H, W) bool)."""
-    depth = 1.0 - height.astype(np.float64)
     uv, view = rays(grid)
-    exact = ref.exact_hit(depth, uv, view, HEIGHT_SCALE)
-    ok = exact.valid
-    exact_uv = np.mod(exact.uv[ok], 1.0)
-    exact_t = exact.t[ok]
-    hits = {t: probe(t, height, uv[ok], view, HEIGHT_SCALE) for t in techniques}
-    rows, masks = [], {}
+    ok, measured = measure_shadows(height, techniques, elevations, uv, view, HEIGHT_SCALE, progress=progress)
     shape = (grid[1], grid[0])
-    for elevation in elevations:
-        direction = light(elevation)
-        truth = ref.shadow(depth, exact_uv, exact_t, direction, HEIGHT_SCALE)
-        if not masks:
-            masks["reference"] = _grid(truth.lit, ok, shape)
-        for technique in techniques:
-            hit = hits[technique]
-            at_exact = shadow_probe(technique, height, exact_uv, exact_t, direction, HEIGHT_SCALE)
-            own = shadow_probe(technique, height, np.mod(hit.uv, 1.0), hit.depth, direction, HEIGHT_SCALE)
-            if len(masks) < 1 + len(techniques):
-                masks.setdefault(technique, _grid(own.lit, ok, shape))
-            fetches = _grid(at_exact.hard_fetches.astype(np.float64), ok, shape)
-            rows.append({
-                "heightmap": name, "technique": technique, "elevation": elevation, "rays": int(ok.sum()),
-                "ref_lit": float(truth.lit.mean()),
-                "hard_wrong": float((at_exact.lit != truth.lit).mean()),
-                "hard_wrong_own_hit": float((own.lit != truth.lit).mean()),
-                "soft_diff": float(np.abs(at_exact.visibility - truth.visibility).mean()),
-                "soft_diff_own_hit": float(np.abs(own.visibility - truth.visibility).mean()),
-                "hard_fetches": float(at_exact.hard_fetches.mean()),
-                "hard_fetches_simd": simd_tile_cost(fetches, covered=_grid(np.ones(ok.sum(), bool), ok, shape)),
-                "soft_fetches": float(at_exact.soft_fetches.mean()),
-                "view_fetches": float(hit.fetches.mean()),
-                "capped": float(at_exact.capped.mean()),
-            })
-            if progress is not None:
-                progress()
+    covered = _grid(np.ones(ok.sum(), bool), ok, shape)
+    first = [m for m in measured if m.elevation == elevations[0]]
+    masks = {"reference": _grid(first[0].ref_lit_rays, ok, shape)} if first else {}
+    masks.update({m.technique: _grid(m.lit, ok, shape) for m in first})
+    rows = [{
+        "heightmap": name, "technique": m.technique, "elevation": m.elevation, "rays": m.rays, "ref_lit": m.ref_lit,
+        "hard_wrong": m.hard_wrong, "hard_wrong_own_hit": m.hard_wrong_own_hit, "soft_diff": m.soft_diff,
+        "soft_diff_own_hit": m.soft_diff_own_hit, "hard_fetches": float(m.hard_fetches.mean()),
+        "hard_fetches_simd": simd_tile_cost(_grid(m.hard_fetches, ok, shape), covered=covered),
+        "soft_fetches": m.soft_fetches, "view_fetches": m.view_fetches, "capped": m.capped,
+    } for m in measured]
     return rows, masks
 
 
