@@ -5,6 +5,10 @@ shader uses (``shaders.compose_technique(..., "filter_probe", filter)``), over a
 uploads albedo (rgba16float, box-filtered mip chain). Tests compare it with the float64 filters of
 ``wgpuviewer.studies.filtering.cpu`` on the same footprints, including ones no render produces (zero, NaN and
 huge derivatives).
+
+``explicit_gradient_support(gpu)`` asks the adapter whether it honours ``textureSampleGrad``'s explicit gradients
+(a small compute probe, run once per device): software adapters (lavapipe) ignore them with an anisotropic
+sampler, so the hardware ``aniso`` filter cannot be measured there.
 """
 
 from __future__ import annotations
@@ -33,6 +37,27 @@ FILTER_OUT = Struct("FilterOut", [("value", "vec4f"), ("texels", "u32"), ("depth
                                   ("hidden", "u32"), ("flags", "u32")], "storage")
 TEXTURE_FORMAT = "rgba16float"  # as the renderer's albedo
 ENTRY = "filter_probe_main"
+
+#: The explicit-gradient probe's records (entry/gradient_probe.wgsl binds an array of each and declares neither):
+#: a uv and gradient pair in; the red channel read through the isotropic and the anisotropic sampler out.
+GRADIENT_SAMPLE = Struct("GradientSample", [("uv", "vec2f"), ("ddx", "vec2f"), ("ddy", "vec2f")], "storage")
+GRADIENT_VALUE = Struct("GradientValue", [("isotropic", "f32"), ("anisotropic", "f32")], "storage")
+GRADIENT_ENTRY = "gradient_probe_main"
+#: The probe texture's side: level 0 horizontal 1-texel stripes (row j is j % 2), so every coarser level is 0.5.
+GRADIENT_TEXTURE = 64
+#: Where it is read: the centre of texel (32, 33), on a stripe of value 1 (level 0 reads 1, any coarser level 0.5).
+GRADIENT_TEXEL = (32, 33)
+#: The probe's gradient pairs (ddx, ddy) in texels: which level each must read when the gradients are honoured.
+GRADIENT_PAIRS = {
+    "tiny": ((0.25, 0.0), (0.0, 0.25)),  # magnified: level 0, 1
+    "huge": ((64.0, 0.0), (0.0, 64.0)),  # the 1x1 level: 0.5
+    "thin": ((16.0, 0.0), (0.0, 1.0)),  # 16:1 along the stripes: level 0 with max_anisotropy 16, 1; level 4 without
+    "round": ((16.0, 0.0), (0.0, 16.0)),  # level 4 for any sampler: 0.5
+}
+#: The anisotropic sampler's max_anisotropy (WebGPU's largest, the study's `aniso 16`).
+GRADIENT_ANISOTROPY = 16
+#: Smallest difference between two of the probe's reads that shows a level change (level 0 vs coarser: 0.5).
+GRADIENT_CONTRAST = 0.25
 
 
 @dataclass
@@ -122,3 +147,91 @@ def filter_probe(
     groups = [material, *[None] * (FILTER_GROUP - 2), filter_group]
     out = dispatch(kernel, ENTRY, groups, n, in_buf, out_buf, FILTER_OUT)
     return FilterProbeResult(**{name: out[name].copy() for name in FILTER_OUT.names})  # FilterOut's fields, by name
+
+
+@dataclass(frozen=True)
+class GradientProbe:
+    """What the explicit-gradient probe read (GRADIENT_PAIRS name -> red value) through each sampler."""
+
+    adapter: str
+    isotropic: dict[str, float]
+    anisotropic: dict[str, float]
+
+    @property
+    def ignored(self) -> list[str]:
+        return ignored_gradients(self.isotropic, self.anisotropic)
+
+    @property
+    def honoured(self) -> bool:
+        return not self.ignored
+
+
+def ignored_gradients(isotropic: dict[str, float], anisotropic: dict[str, float]) -> list[str]:
+    """The decision of the explicit-gradient probe, from its reads (GRADIENT_PAIRS name -> value): what the
+    adapter ignores, as phrases for a sentence ([] when it honours the gradients). Honoured gradients read level 0
+    (1) at the tiny pair and a coarse level (0.5) at the huge one through both samplers, and level 0 at the 16:1
+    thin pair through the anisotropic sampler where the round pair of the same major axis reads level 4."""
+    def finer(values: dict[str, float], fine: str, coarse: str) -> bool:
+        difference = values[fine] - values[coarse]
+        return bool(np.isfinite(difference) and difference > GRADIENT_CONTRAST)
+
+    ignored = []
+    if not finer(isotropic, "tiny", "huge"):
+        ignored.append("length with an isotropic sampler")
+    if not finer(anisotropic, "tiny", "huge"):
+        ignored.append(f"length with an anisotropic sampler (max_anisotropy {GRADIENT_ANISOTROPY})")
+    if not finer(anisotropic, "thin", "round"):
+        ignored.append("shape: through the anisotropic sampler a 16:1 pair reads a round pair's level")
+    return ignored
+
+
+def gradient_probe_texture() -> np.ndarray:
+    """The probe texture's level 0 (RGBA): horizontal 1-texel stripes, row j = j % 2."""
+    rows = np.arange(GRADIENT_TEXTURE) % 2
+    return np.broadcast_to(rows[:, None, None], (GRADIENT_TEXTURE, GRADIENT_TEXTURE, 4)).astype(np.float32)
+
+
+def explicit_gradient_probe(gpu: Gpu) -> GradientProbe:
+    """Run the explicit-gradient probe on ``gpu`` (once per device: the result is kept in ``gpu.cache``)."""
+    with gpu.lock:
+        if "explicit-gradients" not in gpu.cache:
+            gpu.cache["explicit-gradients"] = _run_gradient_probe(gpu)
+        return gpu.cache["explicit-gradients"]
+
+
+def _run_gradient_probe(gpu: Gpu) -> GradientProbe:
+    compute = compute_for(gpu)
+    module_parts = (GRADIENT_SAMPLE.generated(), GRADIENT_VALUE.generated(), "entry/gradient_probe.wgsl")
+    kernel = compute.kernel(*module_parts, label="gradient-probe", fix=FIX)
+    names = list(GRADIENT_PAIRS)
+    samples = np.zeros(len(names), GRADIENT_SAMPLE.dtype)
+    samples["uv"] = (np.array(GRADIENT_TEXEL) + 0.5) / GRADIENT_TEXTURE
+    samples["ddx"] = [np.array(GRADIENT_PAIRS[n][0]) / GRADIENT_TEXTURE for n in names]
+    samples["ddy"] = [np.array(GRADIENT_PAIRS[n][1]) / GRADIENT_TEXTURE for n in names]
+    with compute.guard("explicit-gradient probe", FIX):
+        texture = create_texture(gpu, mip_chain(gradient_probe_texture()), TEXTURE_FORMAT, "gradient-probe:stripes")
+        linear = {"mag_filter": "linear", "min_filter": "linear", "mipmap_filter": "linear"}
+        isotropic = gpu.device.create_sampler(label="gradient-probe:isotropic", **linear)
+        anisotropic = gpu.device.create_sampler(label="gradient-probe:anisotropic", max_anisotropy=GRADIENT_ANISOTROPY,
+                                                **linear)
+        group = kernel.bind(GRADIENT_ENTRY, {0: texture.create_view(), 1: isotropic, 2: anisotropic}, group=1)
+        in_buf = compute.storage(GRADIENT_SAMPLE.pack_many(samples), "gradient-probe:samples", FIX)
+        out_buf = compute.storage(len(names) * GRADIENT_VALUE.size, "gradient-probe:values", FIX)
+        out = dispatch(kernel, GRADIENT_ENTRY, [group], len(names), in_buf, out_buf, GRADIENT_VALUE)
+    return GradientProbe(gpu.summary, {n: float(v) for n, v in zip(names, out["isotropic"])},
+                         {n: float(v) for n, v in zip(names, out["anisotropic"])})
+
+
+def explicit_gradient_support(gpu: Gpu) -> bool:
+    """Whether ``gpu`` honours ``textureSampleGrad``'s explicit gradients, with isotropic and anisotropic samplers
+    (without, the ``aniso`` filter's footprint is not the derivative source's, and its numbers are the driver's)."""
+    return explicit_gradient_probe(gpu).honoured
+
+
+def explicit_gradient_note(gpu: Gpu) -> str:
+    """One sentence for reports when ``gpu`` ignores explicit gradients ("" when it honours them)."""
+    probe = explicit_gradient_probe(gpu)
+    if probe.honoured:
+        return ""
+    return (f"{probe.adapter} ignores textureSampleGrad's explicit gradients ({'; '.join(probe.ignored)}), so "
+            "the hardware `aniso` filter cannot be measured validly on it.")
