@@ -54,7 +54,11 @@ PARAMS = {
         ("cot_hi", "vec4f"),  # cot of its largest polar angle
         ("inv_sin_hi", "vec4f"),  # 1 / sin of its largest polar angle
         ("cap", "vec4f"),  # reach / sin of its largest polar angle
-        ("dz", "f32"), ("grow", "f32"), ("margin", "f32"), ("sw", "f32")]),  # as distance.wgsl's
+        ("dz", "f32"), ("grow", "f32"), ("margin", "f32"), ("sw", "f32"),  # as distance.wgsl's
+        ("visibility", "u32"),  # 1: cut each voxel's polar range by reach_cot (the paper's visibility condition)
+        ("rings", "u32"),  # horizon: backward distances tested, ring n at (n + 1) * horizon_step
+        ("horizon_step", "f32"), ("reach", "f32"),
+        ("cot_slack", "f32")]),  # cot of the bins' angle slack (maptools.refined.COT_SLACK)
     "cone.wgsl": Struct("Params", [
         ("width", "u32"), ("height", "u32"), ("rings", "u32"), ("sy", "f32"), ("max_ratio", "f32"),
         ("keep", "f32"),  # 1 - store margin
@@ -283,10 +287,10 @@ def distance(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: f
 @_guard("distance.wgsl", "distance_refined.wgsl")
 def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05,
                      subcells: int = 4, max_angle: float = 85.0, sectors: int = 4, bands: int = 8,
-                     reach: float = 16.0, progress: bool = True):
+                     reach: float = 16.0, visibility: str = "off", progress: bool = True):
     """GPU twin of refined.distance_refined, baked in slabs of slices: per slab the plain volume (distance.wgsl),
     then one dispatch of distance_refined.wgsl per azimuth sector and group of up to 4 bands, each read back and
-    rounded down to float16."""
+    rounded down to float16. With the visibility condition, each sector's cut (``horizon``) first, per slab."""
     from tqdm import tqdm
 
     from . import distance as dist
@@ -295,7 +299,9 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
     h, w = height.shape
     rf.check(w, h, slices, sectors, bands)
     dist.check_subcells(subcells, "distance_refined")
+    rf.check_visibility(visibility)
     g.check_size(h, w)
+    visible = visibility == "on"
     lanes = min(bands, rf.BANDS_PER_PASS)
     slab = _slab_slices(g, w, h, slices, subcells, lanes)
     directions = rf.bins(sectors, bands, max_angle)
@@ -310,6 +316,19 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
     vol = g.storage(lanes * w * h * slab * 4, "maptools distance_refined band volumes")
     windows = g.storage(levels * w * h * 4, "maptools distance_refined window tops")
     columns = [g.storage(e.packed(w, h, subcells), "maptools distance_refined columns") for e in lists]
+    cut = rings = ring_ends = None
+    if visible:
+        inner = g.storage(w * h * 4, "maptools distance_refined inner tops")
+        cut = g.storage(w * h * slab * 4, "maptools distance_refined visibility cut")
+        rings, ring_ends = [], []
+        for b in rf.bins(sectors, 1, max_angle):
+            ring = rf.horizon_rings(b, w / h, reach)
+            offsets = np.zeros((max(1, sum(len(ox) for ox, _ in ring)), 2), np.uint32)
+            offsets[:sum(len(ox) for ox, _ in ring)] = np.concatenate(
+                [np.stack([np.mod(ox, w), np.mod(oy, h)], axis=1) for ox, oy in ring])
+            rings.append(g.storage(offsets, "maptools distance_refined rings"))
+            ends = np.cumsum([len(ox) for ox, _ in ring]).astype(np.uint32)
+            ring_ends.append(g.storage(ends, "maptools distance_refined ring ends"))
     out = np.empty((len(directions) + 1, slices, h, w), np.float16)
     groups = [(s, b0) for s in range(sectors) for b0 in range(0, bands, rf.BANDS_PER_PASS)]
     passes = [(slab_, group) for slab_ in _slabs(slices, slab) for group in groups]
@@ -325,15 +344,22 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
             "tan_lo": [d.tan_lo for d in group] + lane, "cot_hi": [d.cot_hi for d in group] + lane,
             "inv_sin_hi": [1.0 / d.sin_hi for d in group] + lane, "cap": [reach / d.sin_hi for d in group] + lane,
             "dz": height_scale * w / slices, "grow": dist.BOX_GROW, "margin": dist.STORE_MARGIN,
-            "sw": height_scale * w})
+            "sw": height_scale * w, "visibility": int(visible), "rings": rf.ring_count(reach),
+            "horizon_step": rf.HORIZON_STEP, "reach": reach, "cot_slack": rf.COT_SLACK})
         enc = g.encoder("maptools distance_refined pass")
         if not windows_done:
             g.dispatch(enc, "distance_refined.wgsl", "window_tops", {0: p, 1: src, 2: windows}, w, h, levels)
+            if visible:
+                g.dispatch(enc, "distance_refined.wgsl", "inner_tops", {0: p, 1: src, 2: inner}, w, h)
             windows_done = True
         if (sector, b0) == groups[0]:  # the slab's plain values, which every pass of the slab floors at
             _plain_slab(g, enc, tops, rows, plain, w, h, first, count, slices, height_scale, subcells)
+        if visible and b0 == 0:  # the sector's cut for the slab, which its band groups share
+            g.dispatch(enc, "distance_refined.wgsl", "horizon",
+                       {0: p, 1: inner, 2: cut, 7: rings[sector], 8: ring_ends[sector]}, w, h)
         g.dispatch(enc, "distance_refined.wgsl", "main",
-                   {0: p, 1: plain, 2: vol, 3: tops, 4: windows, 5: columns[sector]}, w, h, count)
+                   {0: p, 1: plain, 2: vol, 3: tops, 4: windows, 5: columns[sector], 6: cut if visible else plain},
+                   w, h, count)
         g.submit(enc)
         if (sector, b0) == groups[0]:
             stored = dist.round_down(g.read(plain, n).astype(np.float64), np.float16)

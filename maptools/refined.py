@@ -21,6 +21,23 @@ bound over the listed columns (offsets whose rho < ``reach``, near ones as sub-c
 whose column contains the sub-cells'), capped at reach / sin b (every unlisted column is farther than that), and
 never below the plain value of B (a bound for every direction). No direction sampling, no march, no slack
 beyond the store margin; closed form per column.
+
+The paper's visibility condition (``visibility="on"``): a tracer reads B's value only at a point p it reached
+through free space, so a direction w whose backward path from every point of B passes through the relief cannot
+be the direction of a ray reading B, and need not bound B's value. Whether a backward path is blocked is decided
+against the inner solid I (cell columns from the DEEPEST of the cell's four corners down: inside the bilinear
+solid): at backward horizontal distance x along -u (u the azimuth of w), every point of B has risen by x cot
+(polar) and lies over the footprint F shifted by -x u; if even B's top face is below every inner column those
+shifted footprints touch (for every azimuth of the sector), every such path is inside the relief there. So with
+M(x) the deepest inner top (largest Z) over the cells any shifted footprint touches,
+
+    every w of the sector with cot(polar) < g = max over x of (top(B) - M(x)) / x   is blocked,
+
+and the rays that can read B have polar angles <= arccot(g) (+ ANGLE_SLACK). A blocked-from-above direction is
+monotone in the polar angle (a steeper backward path is higher at every x and the solid is a height field), so
+this cut is the whole condition for the sampled x. The bake then uses [a, min(b, arccot(g))] as the band's polar
+range for B: deep in a narrow pit only steep rays arrive, and a steep ray's bound past the pit walls is long.
+x runs over HORIZON_STEP, 2 HORIZON_STEP, ... up to the reach; fewer x only finds fewer blocked directions (safe).
 """
 
 from __future__ import annotations
@@ -52,6 +69,12 @@ MAX_BANDS = 16
 FAR_RATIO = 4.0
 #: Polar bands the GPU bake computes in one walk over a sector's columns (one per vec4 lane).
 BANDS_PER_PASS = 4
+#: The paper's visibility condition: off (every direction of a bin bounds a voxel) or on (only directions that can
+#: reach the voxel unblocked from the top of the relief).
+VISIBILITY_CHOICES = ("off", "on")
+#: Backward horizontal distances (texels) at which a direction is tested for being blocked: multiples of this, up
+#: to the reach.
+HORIZON_STEP = 0.5
 
 
 @dataclass(frozen=True)
@@ -246,6 +269,91 @@ def entries(b: Bin, k: int, sy: float, reach: float) -> Entries:
                    r.astype(np.float64))
 
 
+# -- the visibility condition ------------------------------------------------------------------------
+
+def inner_tops(depth: np.ndarray) -> np.ndarray:
+    """Top of the inner solid's column over each bilinear cell [i + 0.5, i + 1.5] x [j + 0.5, j + 1.5] (texels): the
+    DEEPEST of its four corner depths (the bilinear patch is nowhere deeper), float64 (H, W) at [j, i]."""
+    d = np.asarray(depth, np.float64)
+    right = np.roll(d, -1, axis=1)
+    return np.maximum(np.maximum(d, right), np.maximum(np.roll(d, -1, axis=0), np.roll(right, -1, axis=0)))
+
+
+def ring_count(reach: float) -> int:
+    """Backward distances tested: HORIZON_STEP, 2 HORIZON_STEP, ... up to the reach."""
+    return int(math.floor(reach / HORIZON_STEP + 1e-9))
+
+
+def horizon_rings(b: Bin, sy: float, reach: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per backward distance x = n HORIZON_STEP (n = 1, 2, ... up to the reach): the cell offsets (ox, oy) from a
+    voxel's own cell whose cell the voxel's footprint, shifted by -x u for an azimuth u of ``b``'s wedge, can touch.
+    The shifts f - q (f in the footprint, q in the cell) fill a rectangle; the cell is listed when the wedge's arc
+    of radius x may meet it (its least length within the wedge <= x <= its farthest corner): a superset, so
+    the deepest inner top over the list is never shallower than the one over the cells really touched (safe)."""
+    g = dist.BOX_GROW
+    n = ring_count(reach)
+    rx, ry = math.ceil(reach) + 3, math.ceil(reach / sy) + 3
+    oy, ox = (a.ravel() for a in np.mgrid[-ry:ry + 1, -rx:rx + 1])
+    x0, x1 = -ox - 1.5 - g, -ox + 0.5 + g
+    y0, y1 = -(oy + 1.5) * sy - g, -(oy - 0.5) * sy + g
+    near = wedge_rho(x0, x1, y0, y1, b)
+    far = np.hypot(np.maximum(np.abs(x0), np.abs(x1)), np.maximum(np.abs(y0), np.abs(y1)))
+    out = []
+    for step in range(1, n + 1):
+        x = step * HORIZON_STEP
+        on = (near <= x + 1e-9) & (far >= x - 1e-9)
+        out.append((ox[on], oy[on]))
+    return out
+
+
+#: cot(ANGLE_SLACK): widening a polar angle arccot(g) by the slack gives cot = (g COT_SLACK - 1) / (g + COT_SLACK).
+COT_SLACK = 1.0 / math.tan(ANGLE_SLACK)
+
+
+def widened_cot(g):
+    """cot(arccot(g) + ANGLE_SLACK) for g > 0, else 0 (no cut): the visibility cut widened as the bins are."""
+    g = np.asarray(g, np.float64)
+    return np.maximum((g * COT_SLACK - 1.0) / (g + COT_SLACK), 0.0)
+
+
+def horizon(depth: np.ndarray, slices: int, height_scale: float, sectors: int, max_angle: float,
+            reach: float) -> np.ndarray:
+    """The visibility cut per sector and voxel, float64 (sectors, Dz, H, W): the cot of the largest polar angle of
+    a ray of the sector that can reach the voxel box unblocked (widened by ANGLE_SLACK), 0 where nothing is cut.
+    g = max over x of (top of the box - the deepest inner top over the x ring) / x (module docstring)."""
+    h, w = depth.shape
+    sw = height_scale * w
+    tops = inner_tops(depth) * sw
+    box_tops = np.arange(slices, dtype=np.float64) * (sw / slices) - dist.BOX_GROW
+    jj, ii = np.arange(h), np.arange(w)
+    out = np.zeros((sectors, slices, h, w))
+    for s, b in enumerate(bins(sectors, 1, max_angle)):
+        g = np.zeros((slices, h, w))
+        for n, (ox, oy) in enumerate(horizon_rings(b, w / h, reach), start=1):
+            if not ox.size:
+                continue
+            m = np.full((h, w), -np.inf)
+            for dx, dy in zip(ox, oy):
+                np.maximum(m, tops[(jj + dy) % h][:, (ii + dx) % w], out=m)
+            np.maximum(g, (box_tops[:, None, None] - m[None]) / (n * HORIZON_STEP), out=g)
+        out[s] = widened_cot(g)
+    return out
+
+
+def polar_top(b: Bin, reach: float, reach_cot: np.ndarray | None):
+    """(cot, 1 / sin, reach / sin) of the largest polar angle of bin ``b``'s rays that can read each voxel: the
+    bin's own where ``reach_cot`` (``horizon``'s, for the bin's sector) does not cut it, else arccot(reach_cot),
+    but never below the bin's least polar angle (no ray of the bin reaches such a voxel; its value is then the
+    bound for rays exactly at that angle). As the GPU bake computes them."""
+    if reach_cot is None:
+        return np.float64(b.cot_hi), np.float64(1.0 / b.sin_hi), np.float64(reach / b.sin_hi)
+    cut = reach_cot > b.cot_hi
+    cot = np.where(cut, reach_cot, b.cot_hi)
+    cot = np.where(cot * b.tan_lo > 1.0, 1.0 / max(b.tan_lo, 1e-300), cot)
+    inv_sin = np.where(cut, np.sqrt(1.0 + cot * cot), 1.0 / b.sin_hi)
+    return cot, inv_sin, np.where(cut, reach * inv_sin, reach / b.sin_hi)
+
+
 # -- the bake (CPU reference) --------------------------------------------------------------------------
 
 #: Active voxels are compacted after this many columns (speed only).
@@ -253,22 +361,24 @@ _COMPACT_EVERY = 8
 
 
 def bake(sub_tops: np.ndarray, windows: list[np.ndarray], plain: np.ndarray, b: Bin, e: Entries, k: int,
-         bottoms: np.ndarray, reach: float) -> np.ndarray:
+         bottoms: np.ndarray, reach: float, reach_cot: np.ndarray | None = None) -> np.ndarray:
     """One bin's volume (float64, before rounding): the least bound over the final columns of ``e``, capped at
     reach / sin b, floored at ``plain`` (the stored plain volume (Dz, H, W)). ``sub_tops`` (H K, W K) and
-    ``windows`` (level L - 1 -> (H, W)) are column tops in metric Z, ``bottoms`` each slice's box bottom."""
+    ``windows`` (level L - 1 -> (H, W)) are column tops in metric Z, ``bottoms`` each slice's box bottom;
+    ``reach_cot`` (Dz, H, W): the visibility condition's cut of the polar range per voxel (None: off)."""
     dz, h, w = plain.shape
     floor = plain.astype(np.float64).ravel()
     kk, jj, ii = (a.ravel() for a in np.indices((dz, h, w)))
-    best = np.full(floor.shape, reach / b.sin_hi)
+    cot_hi, inv_sin, best = (np.broadcast_to(a, (dz, h, w)).ravel() for a in polar_top(b, reach, reach_cot))
+    best = best.copy()
     active = np.arange(floor.size)
-    tan_lo, cot_hi, inv_sin = b.tan_lo, b.cot_hi, 1.0 / b.sin_hi
+    tan_lo = b.tan_lo
     sub = sub_tops.ravel()
     order = np.flatnonzero(e.final)
     order = order[np.argsort(e.rho[order], kind="stable")]
     for n, q in enumerate(order):
         if n % _COMPACT_EVERY == 0:
-            active = active[(best[active] > e.rho[q] * inv_sin) & (best[active] > floor[active])]
+            active = active[(best[active] > e.rho[q] * inv_sin[active]) & (best[active] > floor[active])]
         if not active.size:
             break
         j, i = jj[active], ii[active]
@@ -278,7 +388,7 @@ def bake(sub_tops: np.ndarray, windows: list[np.ndarray], plain: np.ndarray, b: 
             top = windows[e.level[q] - 1].ravel()[((j + e.oy[q]) % h) * w + (i + e.ox[q]) % w]
         z0 = np.maximum(top - bottoms[kk[active]], 0.0)
         r = np.maximum(e.rho[q], z0 * tan_lo)
-        depth = np.maximum(z0, r * cot_hi)
+        depth = np.maximum(z0, r * cot_hi[active])
         # voxels past their own exit (every later column is at least `bound` away) cannot lower their value
         best[active] = np.minimum(best[active], np.sqrt(r * r + depth * depth))
     return np.maximum(floor, best - dist.STORE_MARGIN).reshape(dz, h, w)
@@ -313,16 +423,24 @@ def check(w: int, h: int, slices: int, sectors: int, bands: int, kind: str = "di
     return volumes
 
 
+def check_visibility(visibility: str) -> None:
+    if visibility not in VISIBILITY_CHOICES:
+        raise UserError(f"distance_refined: option visibility={visibility!r}; expected one of "
+                        f"{', '.join(VISIBILITY_CHOICES)}")
+
+
 def distance_refined(height: np.ndarray, *, slices: int = 16, height_scale: float = 0.05, subcells: int = 4,
                      max_angle: float = 85.0, sectors: int = 4, bands: int = 8, reach: float = 16.0,
-                     progress: bool = True) -> np.ndarray:
+                     visibility: str = "off", progress: bool = True) -> np.ndarray:
     """Direction-binned refined volumes, float16 (V, Dz, H, W) rounded down: volume band * sectors + sector for
-    the rays of that bin, the last one the plain map (rays steeper than max_angle)."""
+    the rays of that bin, the last one the plain map (rays steeper than max_angle). ``visibility`` "on": each
+    voxel bounded only for the directions that can reach it unblocked (the paper's condition)."""
     from tqdm import tqdm
 
     hh, w = height.shape
     check(w, hh, slices, sectors, bands)
     dist.check_subcells(subcells, "distance_refined")
+    check_visibility(visibility)
     depth = 1.0 - height.astype(np.float64)
     sw = height_scale * w
     plain = dist.store(dist.box_distance(depth, slices, height_scale, subcells))
@@ -330,9 +448,11 @@ def distance_refined(height: np.ndarray, *, slices: int = 16, height_scale: floa
     bottoms = dist.box_bottoms(slices, height_scale, w)
     lists = [entries(b, subcells, w / hh, reach) for b in bins(sectors, bands, max_angle)]
     windows = window_tops(depth, max(e.levels for e in lists), sw)
+    cuts = horizon(depth, slices, height_scale, sectors, max_angle, reach) if visibility == "on" else None
     out = []
-    for b, e in tqdm(list(zip(bins(sectors, bands, max_angle), lists)), desc="distance_refined (cpu)", unit="bin",
-                     disable=None if progress else True, leave=False):
-        out.append(dist.round_down(bake(sub_tops, windows, plain, b, e, subcells, bottoms, reach), np.float16))
+    for n, (b, e) in enumerate(tqdm(list(zip(bins(sectors, bands, max_angle), lists)), desc="distance_refined (cpu)",
+                                    unit="bin", disable=None if progress else True, leave=False)):
+        cut = None if cuts is None else cuts[n % sectors]
+        out.append(dist.round_down(bake(sub_tops, windows, plain, b, e, subcells, bottoms, reach, cut), np.float16))
     out.append(dist.round_down(plain.astype(np.float64), np.float16))
     return np.stack(out)

@@ -263,11 +263,15 @@ KINDS: dict[str, Kind] = {
                    lo=1, hi=rf.MAX_BANDS),
             Option("reach", 16.0, float, "columns farther than this (texels, horizontally) are not looked at; "
                    "values are capped near it", lo=1.0, hi=256.0),
+            Option("visibility", "off", str, "the paper's visibility condition: on = each voxel bounded only for "
+                   "the directions that can reach it unblocked from the top (with sectors 1, bands 1: the paper's map)",
+                   choices=rf.VISIBILITY_CHOICES),
         ),
         cpu=rf.distance_refined, gpu=gpu.distance_refined, compare=_compare_refined,
         tolerance=f"|difference| <= max({DISTANCE_TOL:g} texel, one float16 step) on every value",
         writer=io.write_volume, extensions=(".npy",),
-        cases=(Case({"slices": 4, "height_scale": 0.3, "sectors": 2, "bands": 2}, 2048),),
+        cases=(Case({"slices": 4, "height_scale": 0.3, "sectors": 2, "bands": 2}, 2048),
+               Case({"slices": 4, "height_scale": 0.3, "sectors": 4, "bands": 5, "visibility": "on"}, 2048)),
     ),
     "cone": Kind(
         name="cone",

@@ -20,6 +20,7 @@ from tests.maptools.helpers import adversarial_maps, smooth_tileable
 from wgpuviewer.core.compute import Compute
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.relief.reference import exact_hit, sample_bilinear, view_dir_from_angles
+from wgpuviewer.studies.refined_distance import reliefs
 
 RNG = np.random.default_rng(1234)
 
@@ -38,6 +39,8 @@ def relief_maps() -> dict[str, np.ndarray]:
     out["smooth_40x24"] = smooth_tileable(24, 40, 3)
     out["walls"] = walls()
     out["noise"] = RNG.random((20, 20)).astype(np.float32)
+    out["plate"] = reliefs.plate(36)  # the paper's relief: deep narrow pits and slots
+    out["grille"] = reliefs.grille(42)
     return out
 
 
@@ -283,27 +286,33 @@ def adversarial_rays(n, shape, edges, sectors, rng):
 
 
 TRACE_CASES = [("walls", 0.5, 16), ("noise", 0.6, 12), ("spike", 0.5, 8), ("wall", 0.4, 8), ("checker", 0.5, 8),
-               ("smooth_40x24", 0.5, 12), ("step", 0.3, 10), ("flat1", 0.2, 4), ("one_texel", 0.1, 4)]
+               ("smooth_40x24", 0.5, 12), ("step", 0.3, 10), ("flat1", 0.2, 4), ("one_texel", 0.1, 4),
+               ("plate", 0.4, 12), ("grille", 0.3, 12)]
 BANDS = 4
 
 
 @pytest.mark.parametrize("name,s,slices", TRACE_CASES)
 def test_sphere_tracing_never_tunnels(name, s, slices):
-    """docs/maps.md's loop with a tiny stop radius through the plain map and the refined map (each ray reading its
-    own volume): the stop point is never behind the float64 exact hit."""
+    """docs/maps.md's loop with a tiny stop radius through the plain map and the refined maps (each ray reading its
+    own volume; the binned map and the paper's single cone, the visibility condition off and on): the stop point is
+    never behind the float64 exact hit."""
     h = MAPS[name]
     rng = np.random.default_rng(len(name))
     plain = maptools.generate("distance", h, backend="cpu", slices=slices, height_scale=s)
-    refined = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s, sectors=8,
-                                bands=BANDS, reach=8.0, max_angle=80.0)
     uv, v = cone_rays(1500, 89.0, rng)
     uv2, v2 = adversarial_rays(120, h.shape, np.degrees(rf.band_edges(BANDS, 80.0)), 8, rng)
     uv, v = np.concatenate([uv, uv2]), np.concatenate([v, v2])
     hit = exact_hit(1.0 - h.astype(np.float64), uv, v, s)
     assert hit.valid.all()
-    for vol, which in ((plain, None), (refined, rf.volume_index(v, 8, BANDS, 80.0))):
+    maps = [("plain", plain, None)]
+    for visibility in rf.VISIBILITY_CHOICES:
+        for sectors, bands in ((8, BANDS), (1, 1)):
+            vol = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s,
+                                    sectors=sectors, bands=bands, reach=8.0, max_angle=80.0, visibility=visibility)
+            maps.append((f"{sectors}x{bands} {visibility}", vol, rf.volume_index(v, sectors, bands, 80.0)))
+    for label, vol, which in maps:
         t, _, _ = sphere_trace(vol, uv, v, s, stop=1e-3, max_steps=600, which=which)
-        assert (t <= hit.t + 1e-9).all(), f"{int((t > hit.t + 1e-9).sum())} rays tunnelled"
+        assert (t <= hit.t + 1e-9).all(), f"{label}: {int((t > hit.t + 1e-9).sum())} rays tunnelled"
 
 
 def free_paths(depth, p, w, s):
@@ -320,16 +329,19 @@ def free_paths(depth, p, w, s):
     return (hit.t - t_p) * per_t, hit.valid & (hit.t >= t_p)
 
 
-@pytest.mark.parametrize("name", ["walls", "spike", "checker", "smooth_40x24", "wall", "step", "noise_odd"])
-def test_refined_value_never_exceeds_the_free_path(name):
+@pytest.mark.parametrize("visibility", rf.VISIBILITY_CHOICES)
+@pytest.mark.parametrize("name", ["walls", "spike", "checker", "smooth_40x24", "wall", "step", "noise_odd", "plate",
+                                  "grille"])
+def test_refined_value_never_exceeds_the_free_path(name, visibility):
     """The stored invariant itself: for random states (p above the surface, w uniform in a bin, on its edges too)
     that a ray can reach (the line from the top plane to p is free), the value of p's voxel in w's bin is at most
-    the exact free path from p along w."""
+    the exact free path from p along w. With the visibility condition on, values are raised only where no
+    reachable state needs them lower."""
     h = MAPS[name]
     rows, cols = h.shape
     slices, s = 8, 0.4
     vol = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s, sectors=8,
-                            bands=BANDS, reach=8.0, max_angle=80.0).astype(np.float64)
+                            bands=BANDS, reach=8.0, max_angle=80.0, visibility=visibility).astype(np.float64)
     depth = 1.0 - h.astype(np.float64)
     rng = np.random.default_rng(3)
     n = 20000
@@ -354,7 +366,8 @@ def test_refined_value_never_exceeds_the_free_path(name):
     assert reachable.sum() > 2000
     over = reachable & (value > free + 1e-9)
     assert not over.any(), f"{int(over.sum())} states: value above the free path, worst {(value - free)[over].max()}"
-    assert (value[reachable] > vol[-1, k, j, i][reachable]).mean() > 0.1  # the bins do raise values
+    if name not in ("plate", "grille"):  # (most reachable states there are in the plate's top slice: value 0)
+        assert (value[reachable] > vol[-1, k, j, i][reachable]).mean() > 0.1  # the bins do raise values
 
 
 @pytest.mark.parametrize("name", ["walls", "noise"])
@@ -371,12 +384,74 @@ def test_rescaled_plain_map_stays_conservative(name):
         assert (t <= hit.t + 1e-9).all(), s
 
 
+# -- the visibility condition --------------------------------------------------------------------------
+
+@pytest.mark.parametrize("sectors,sy", [(1, 1.0), (4, 1.0), (8, 1.6), (2, 0.7)])
+def test_horizon_rings_hold_every_cell_a_shifted_footprint_touches(sectors, sy):
+    """For random points f of a voxel's footprint, azimuths u of the sector and distances x = n HORIZON_STEP, the
+    cell holding f - x u (its offset from the voxel's own cell) is in ring n."""
+    reach = 6.0
+    rng = np.random.default_rng(sectors)
+    for b in rf.bins(sectors, 1, 80.0):
+        rings = [set(zip(ox.tolist(), oy.tolist())) for ox, oy in rf.horizon_rings(b, sy, reach)]
+        assert len(rings) == rf.ring_count(reach)
+        az = b.az_lo + rng.random(4000) * (b.az_hi - b.az_lo) if not b.full else rng.random(4000) * 2 * np.pi
+        f = rng.random((4000, 2)) * [1.0, sy]
+        for n, ring in enumerate(rings, start=1):
+            x = n * rf.HORIZON_STEP
+            q = f - x * np.stack([np.cos(az), np.sin(az)], axis=1)
+            # cell c covers [c + 0.5, c + 1.5] x [c + 0.5, c + 1.5] sy: the texel-centre grid
+            cells = set(zip(np.floor(q[:, 0] - 0.5).astype(int).tolist(),
+                            np.floor(q[:, 1] / sy - 0.5).astype(int).tolist()))
+            assert cells <= ring, (b, n, cells - ring)
+
+
+@pytest.mark.parametrize("name", ["plate", "grille", "walls", "step"])
+def test_directions_past_the_cut_cannot_reach_the_voxel(name):
+    """The visibility cut's own claim: from every point of a voxel box whose cut is set, a direction of the sector
+    steeper-than-allowed (polar angle just past arccot(cut), widened by the slack) meets the relief before it
+    gets back to the top plane: the line from the top plane to the point is not free."""
+    h = MAPS[name]
+    rows, cols = h.shape
+    slices, s, sectors = 8, 0.4, 4
+    depth = 1.0 - h.astype(np.float64)
+    cut = rf.horizon(depth, slices, s, sectors, 80.0, 8.0)
+    rng = np.random.default_rng(7)
+    bins = rf.bins(sectors, 1, 80.0)
+    sec, k, j, i = (a[rng.permutation(a.size)[:3000]] for a in np.nonzero(cut > 0))
+    assert sec.size > 100
+    dz = s * cols / slices
+    p = np.stack([i + rng.random(i.size), (j + rng.random(j.size)) * cols / rows,
+                  (k + rng.random(k.size)) * dz], axis=1)
+    polar = np.arctan2(1.0, cut[sec, k, j, i]) + 1.5 * rf.ANGLE_SLACK
+    polar = np.minimum(polar + rng.random(polar.size) * (np.pi / 2 - polar) * 0.5, np.radians(89.9))
+    az_lo = np.array([b.az_lo + rf.ANGLE_SLACK for b in bins])[sec]
+    az = az_lo + rng.random(sec.size) * 2 * np.pi / sectors
+    w = np.stack([np.sin(polar) * np.cos(az), np.sin(polar) * np.sin(az), np.cos(polar)], axis=1)
+    _, reachable = free_paths(depth, p, w, s)
+    assert not reachable.any(), f"{int(reachable.sum())} states past the cut are reachable"
+
+
+def test_visibility_only_raises_values_and_raises_them_in_pits():
+    """On: never below off (the cut only narrows a voxel's directions), and free voxels rise: most of the plate's
+    (its holes are 5 texels across), some of the grille's (its 1- and 2-texel slots hold hardly a free voxel)."""
+    for name, least in (("plate", 0.5), ("grille", 0.03)):
+        opts = {"slices": 8, "height_scale": 0.4, "sectors": 4, "bands": 2, "max_angle": 80.0}
+        off = maptools.generate("distance_refined", MAPS[name], backend="cpu", **opts).astype(np.float64)
+        on = maptools.generate("distance_refined", MAPS[name], backend="cpu", visibility="on", **opts)
+        on = on.astype(np.float64)
+        assert (on >= off).all() and np.array_equal(on[-1], off[-1])  # the plain volume is untouched
+        free = off[:-1] > 0
+        assert (on[:-1] > off[:-1])[free].mean() > least, name
+
+
 # -- GPU vs CPU -----------------------------------------------------------------------------------------
 
 GPU_CASES = [("smooth_40x24", 0.3, 8, {}), ("noise_odd", 0.5, 6, {"subcells": 1}), ("spike", 0.5, 4, {}),
              ("walls", 0.5, 6, {"subcells": 8}), ("flat0", 0.2, 3, {}), ("one_texel", 0.1, 3, {}),
              ("checker", 0.4, 5, {"subcells": 2})]
-REFINED_GPU = ({}, {"sectors": 1, "bands": 1}, {"sectors": 16, "bands": 6, "reach": 5.0})
+REFINED_GPU = ({}, {"sectors": 1, "bands": 1}, {"sectors": 16, "bands": 6, "reach": 5.0},
+               {"sectors": 1, "bands": 1, "visibility": "on"}, {"sectors": 2, "bands": 5, "visibility": "on"})
 
 
 @pytest.mark.requires_gpu
@@ -440,7 +515,7 @@ def test_a_bake_whose_single_slice_does_not_fit_names_maptools_options(monkeypat
     ("distance_refined", {"max_angle": 90.0}, "out of range"),
     ("distance_refined", {"sectors": 3}, "expected one of"), ("distance_refined", {"bands": 0}, "out of range"),
     ("distance_refined", {"bands": 17}, "out of range"), ("distance_refined", {"bands": 2.5}, "valid int"),
-    ("distance_refined", {"reach": 0.5}, "out of range"),
+    ("distance_refined", {"reach": 0.5}, "out of range"), ("distance_refined", {"visibility": "yes"}, "expected one of"),
 ])
 def test_bad_options(kind, bad, needle):
     with pytest.raises(UserError, match=needle):
