@@ -13,6 +13,7 @@ import numpy as np
 
 from . import cone as cn
 from . import distance as dist
+from . import refined as rf
 from .registry import Comparison, get_kind
 
 
@@ -30,6 +31,9 @@ class SampledReference:
 SAMPLED: dict[str, SampledReference] = {
     "distance": SampledReference(dist.sample_reference, lambda hw, o: (o["slices"], *hw)),
     "cone": SampledReference(cn.sample_reference, lambda hw, o: hw),
+    "distance_refined": SampledReference(
+        rf.sample_reference, lambda hw, o: (rf.check(hw[1], hw[0], o["slices"], o["sectors"], o["bands"]),
+                                            o["slices"], *hw)),
 }
 #: Values sampled per sampled kind by default: on a 512^2 map each sampled CPU reference then takes 1-2 s on 2 cores
 #: (distance 1.6 s, cone 0.9 s on camera.png), against 43 s and 13 s for the whole references.

@@ -317,25 +317,34 @@ def widened_cot(g):
 
 
 def horizon(depth: np.ndarray, slices: int, height_scale: float, sectors: int, max_angle: float,
-            reach: float) -> np.ndarray:
+            reach: float, at: tuple | None = None) -> np.ndarray:
     """The visibility cut per sector and voxel, float64 (sectors, Dz, H, W): the cot of the largest polar angle of
     a ray of the sector that can reach the voxel box unblocked (widened by ANGLE_SLACK), 0 where nothing is cut.
-    g = max over x of (top of the box - the deepest inner top over the x ring) / x (module docstring)."""
+    g = max over x of (top of the box - the deepest inner top over the x ring) / x (module docstring). ``at``:
+    (slice, row, column) index arrays: the cut at those voxels only, (sectors, N)."""
     h, w = depth.shape
     sw = height_scale * w
     tops = inner_tops(depth) * sw
     box_tops = np.arange(slices, dtype=np.float64) * (sw / slices) - dist.BOX_GROW
-    jj, ii = np.arange(h), np.arange(w)
-    out = np.zeros((sectors, slices, h, w))
+    if at is None:
+        rows, cols = np.arange(h), np.arange(w)
+        above, shape = box_tops[:, None, None], (slices, h, w)
+    else:
+        kk, jj, ii = at
+        above, shape = box_tops[kk], np.shape(kk)
+    out = np.zeros((sectors, *shape))
     for s, b in enumerate(bins(sectors, 1, max_angle)):
-        g = np.zeros((slices, h, w))
+        g = np.zeros(out.shape[1:])
         for n, (ox, oy) in enumerate(horizon_rings(b, w / h, reach), start=1):
             if not ox.size:
                 continue
-            m = np.full((h, w), -np.inf)
-            for dx, dy in zip(ox, oy):
-                np.maximum(m, tops[(jj + dy) % h][:, (ii + dx) % w], out=m)
-            np.maximum(g, (box_tops[:, None, None] - m[None]) / (n * HORIZON_STEP), out=g)
+            if at is None:  # the whole map: one shifted copy of the tops per offset
+                m = np.full((h, w), -np.inf)
+                for dx, dy in zip(ox, oy):
+                    np.maximum(m, tops[(rows + dy) % h][:, (cols + dx) % w], out=m)
+            else:
+                m = tops[(jj[:, None] + oy) % h, (ii[:, None] + ox) % w].max(axis=1)
+            np.maximum(g, (above - m) / (n * HORIZON_STEP), out=g)
         out[s] = widened_cot(g)
     return out
 
@@ -366,10 +375,19 @@ def bake(sub_tops: np.ndarray, windows: list[np.ndarray], plain: np.ndarray, b: 
     reach / sin b, floored at ``plain`` (the stored plain volume (Dz, H, W)). ``sub_tops`` (H K, W K) and
     ``windows`` (level L - 1 -> (H, W)) are column tops in metric Z, ``bottoms`` each slice's box bottom;
     ``reach_cot`` (Dz, H, W): the visibility condition's cut of the polar range per voxel (None: off)."""
-    dz, h, w = plain.shape
-    floor = plain.astype(np.float64).ravel()
-    kk, jj, ii = (a.ravel() for a in np.indices((dz, h, w)))
-    cot_hi, inv_sin, best = (np.broadcast_to(a, (dz, h, w)).ravel() for a in polar_top(b, reach, reach_cot))
+    voxels = tuple(a.ravel() for a in np.indices(plain.shape))
+    cut = None if reach_cot is None else reach_cot.ravel()
+    return bake_at(sub_tops, windows, plain.astype(np.float64).ravel(), voxels, b, e, k, bottoms, reach,
+                   cut).reshape(plain.shape)
+
+
+def bake_at(sub_tops: np.ndarray, windows: list[np.ndarray], floor: np.ndarray, voxels: tuple, b: Bin, e: Entries,
+            k: int, bottoms: np.ndarray, reach: float, reach_cot: np.ndarray | None = None) -> np.ndarray:
+    """``bake``'s values (float64) at the voxels (slice, row, column) = ``voxels`` (flat index arrays) whose plain
+    values are ``floor``; ``reach_cot``: their cuts (None: off). Each voxel's value depends on its own inputs only."""
+    kk, jj, ii = voxels
+    h, w = windows[0].shape
+    cot_hi, inv_sin, best = (np.broadcast_to(a, floor.shape) for a in polar_top(b, reach, reach_cot))
     best = best.copy()
     active = np.arange(floor.size)
     tan_lo = b.tan_lo
@@ -391,7 +409,7 @@ def bake(sub_tops: np.ndarray, windows: list[np.ndarray], plain: np.ndarray, b: 
         depth = np.maximum(z0, r * cot_hi[active])
         # voxels past their own exit (every later column is at least `bound` away) cannot lower their value
         best[active] = np.minimum(best[active], np.sqrt(r * r + depth * depth))
-    return np.maximum(floor, best - dist.STORE_MARGIN).reshape(dz, h, w)
+    return np.maximum(floor, best - dist.STORE_MARGIN)
 
 
 def window_tops(depth: np.ndarray, levels: int, sw: float) -> list[np.ndarray]:
@@ -421,6 +439,48 @@ def check(w: int, h: int, slices: int, sectors: int, bands: int, kind: str = "di
     dist.check_volume(w, h, slices, kind, volumes, MAX_VALUES, "float16", fix)
     dist.check_volume(w, h, slices, kind, fix=fix if fix != FEWER_VALUES else dist.FEWER_SLICES)
     return volumes
+
+
+def sample_reference(height: np.ndarray, index, *, slices: int = 16, height_scale: float = 0.05, subcells: int = 4,
+                     max_angle: float = 85.0, sectors: int = 4, bands: int = 8, reach: float = 16.0,
+                     visibility: str = "off") -> np.ndarray:
+    """``distance_refined(height, ...)[index]`` for a tuple (volume, slice, row, column) of integer index arrays,
+    computed at those voxels only: their plain values (``distance.sample_reference``), their cuts, and ``bake``'s
+    walk over each bin's columns for the voxels of that bin, in the same float64 order."""
+    hh, w = height.shape
+    volumes = check(w, hh, slices, sectors, bands)
+    dist.check_subcells(subcells, "distance_refined")
+    check_visibility(visibility)
+    index = dist.index_arrays(index, (volumes, slices, hh, w))
+    vv, kk, jj, ii = (a.ravel() for a in index)
+    out = np.zeros(vv.shape, np.float16)
+    if not vv.size:
+        return out.reshape(index[0].shape)
+    depth = 1.0 - height.astype(np.float64)
+    sw = height_scale * w
+    floor = dist.sample_reference(height, (kk, jj, ii), slices=slices, height_scale=height_scale,
+                                  subcells=subcells).astype(np.float64)
+    plain = vv == volumes - 1
+    out[plain] = dist.round_down(floor[plain], np.float16)
+    binned = np.flatnonzero(~plain)
+    if binned.size:
+        directions = bins(sectors, bands, max_angle)
+        lists = {v: entries(directions[v], subcells, w / hh, reach) for v in np.unique(vv[binned]).tolist()}
+        windows = window_tops(depth, max(e.levels for e in lists.values()), sw)
+        sub_tops = dist.subcell_tops(depth, subcells) * sw
+        bottoms = dist.box_bottoms(slices, height_scale, w)
+        cuts = None
+        if visibility == "on":
+            cuts = horizon(depth, slices, height_scale, sectors, max_angle, reach, at=(kk[binned], jj[binned],
+                                                                                       ii[binned]))
+        for v, e in lists.items():
+            mine = vv[binned] == v
+            at = binned[mine]
+            cut = None if cuts is None else cuts[v % sectors][mine]
+            values = bake_at(sub_tops, windows, floor[at], (kk[at], jj[at], ii[at]), directions[v], e, subcells,
+                             bottoms, reach, cut)
+            out[at] = dist.round_down(values, np.float16)
+    return out.reshape(index[0].shape)
 
 
 def check_visibility(visibility: str) -> None:

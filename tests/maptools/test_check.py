@@ -12,7 +12,9 @@ import pytest
 from maptools import check, cli, registry
 from maptools import cone as cn
 from maptools import distance as dist
+from maptools import refined as rf
 from tests.maptools.helpers import adversarial_maps, smooth_tileable
+from wgpuviewer.studies.refined_distance import reliefs
 
 #: Small adversarial maps (flat, spike, step, wall, checker, 1x1, NPOT and odd sizes, 8/16-bit) and one non-square one.
 MAPS = {name: h for name, h in adversarial_maps().items() if h.size <= 4000}
@@ -43,6 +45,19 @@ def test_cone_sample_equals_full(name, opts):
     full = cn.cone(h, **opts)
     index = random_index(full.shape, 200, len(name))
     values = cn.sample_reference(h, index, **opts)
+    assert values.dtype == full.dtype and np.array_equal(values, full[index])
+
+
+@pytest.mark.parametrize("opts", [{"slices": 4, "height_scale": 0.3, "sectors": 2, "bands": 3, "reach": 6.0},
+                                  {"slices": 3, "height_scale": 0.5, "sectors": 4, "bands": 2, "reach": 5.0,
+                                   "visibility": "on", "subcells": 2},
+                                  {"slices": 5, "height_scale": 0.4, "sectors": 1, "bands": 1, "visibility": "on"}])
+@pytest.mark.parametrize("name", ["spike", "step", "checker", "smooth_23x37", "plate"])
+def test_refined_sample_equals_full(name, opts):
+    h = reliefs.plate(24) if name == "plate" else MAPS[name]
+    full = rf.distance_refined(h, progress=False, **opts)
+    index = random_index(full.shape, 300, len(name))
+    values = rf.sample_reference(h, index, **opts)
     assert values.dtype == full.dtype and np.array_equal(values, full[index])
 
 
