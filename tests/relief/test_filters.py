@@ -200,7 +200,7 @@ def test_visibility_filters_equal_their_float64_twins(gpu, name, relief):
         view = view_dir_from_angles(angle, azimuth)
         uv, dx, dy = footprints(60, (64, 48), seed=int(angle))
         got, want = gpu_and_cpu(name, texture, uv, dx, dy, view, height)
-        ambiguous = np.array([_near_tolerance(depth, w, view) for w in want])
+        ambiguous = np.array([near_tolerance(depth, w, view) for w in want])
         value = np.array([w.value for w in want])
         ok = ~ambiguous
         assert ok.mean() > 0.7
@@ -209,7 +209,7 @@ def test_visibility_filters_equal_their_float64_twins(gpu, name, relief):
         assert got.hidden.sum() > 0
 
 
-def _near_tolerance(depth, filtered: cpu.Filtered, view) -> bool:
+def near_tolerance(depth, filtered: cpu.Filtered, view) -> bool:
     """Whether one of the texel centres the twin tested has a float64 margin within a factor 3 of VIS_TOLERANCE:
     float32 traces may decide those either way (near-tangent contacts are ill-conditioned: a maxmip hit 1e-3
     short of the float64 one was seen)."""
@@ -297,20 +297,23 @@ def test_row_ends_method_keeps_the_gain_at_a_step(gpu):
 # --- degenerate footprints -------------------------------------------------------------------------------
 
 
+#: Degenerate footprints: uv, dx, dy, the flag a filter that uses derivatives must set (0: none).
+DEGENERATE = {
+    "zero": ([0.3, 0.6], [0.0, 0.0], [0.0, 0.0], 0),
+    "nan dx": ([0.3, 0.6], [np.nan, 0.1], [0.0, 0.01], FLAGS["nonfinite"]),
+    "inf dy": ([0.3, 0.6], [0.01, 0.0], [0.0, -np.inf], FLAGS["nonfinite"]),
+    "nan uv": ([np.nan, 0.6], [0.01, 0.0], [0.0, 0.01], FLAGS["nonfinite"]),
+    "huge": ([0.3, 0.6], [1e30, 3e29], [1e-3, 2e30], FLAGS["huge"]),
+    "huge thin": ([0.3, 0.6], [1e20, 0.0], [0.0, 1e-20], FLAGS["huge"]),
+    "far tiling": ([1e5 + 0.3, -1e5], [0.01, 0.0], [0.0, 0.01], 0),
+}
+
+
 @pytest.mark.parametrize("name", list(FILTERS))
 def test_zero_nan_and_huge_derivatives_are_finite_and_flagged(gpu, name):
     texture = textures()["bricks albedo"]
     height = builtin_height("bricks", (64, 64))
-    nan, inf = np.nan, np.inf
-    cases = {  # uv, dx, dy, the flag that must be set (0: none)
-        "zero": ([0.3, 0.6], [0.0, 0.0], [0.0, 0.0], 0),
-        "nan dx": ([0.3, 0.6], [nan, 0.1], [0.0, 0.01], FLAGS["nonfinite"]),
-        "inf dy": ([0.3, 0.6], [0.01, 0.0], [0.0, -inf], FLAGS["nonfinite"]),
-        "nan uv": ([nan, 0.6], [0.01, 0.0], [0.0, 0.01], FLAGS["nonfinite"]),
-        "huge": ([0.3, 0.6], [1e30, 3e29], [1e-3, 2e30], FLAGS["huge"]),
-        "huge thin": ([0.3, 0.6], [1e20, 0.0], [0.0, 1e-20], FLAGS["huge"]),
-        "far tiling": ([1e5 + 0.3, -1e5], [0.01, 0.0], [0.0, 0.01], 0),
-    }
+    cases = DEGENERATE
     uv, dx, dy, want = (np.array([c[k] for c in cases.values()]) for k in range(4))
     f = FILTERS[name]
     for view in ((0.0, 0.0, 1.0), view_dir_from_angles(89.9, 10.0), (1.0, 0.0, 0.0)):

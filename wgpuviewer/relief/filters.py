@@ -92,6 +92,11 @@ _ALPHA = Param("alpha", 6.0, 1.6, 8.0, float, "Gaussian sharpness: weight exp(-a
                "pixels (6: the variance of a one-pixel box; 2: sigma 1/2 pixel)")
 _MAX_TEXELS = Param("max_texels", 256, 4, 4096, int,
                     "texel cap per lookup: a larger footprint is read from a coarser level (flagged capped)")
+#: The visibility filters' weighting of a hidden texel: dropped (0), or inherited by its substitute (1).
+_INHERIT = Param("inherit", 0, 0, 1, int,
+                 "a hidden texel's weight: 0 dropped (the visible texels renormalised), 1 inherited by its "
+                 "substitute, the texel its ray meets, when that lies outside the footprint (one inside is counted "
+                 "once, by the walk)")
 FILTERS: dict[str, Filter] = {
     f.name: f
     for f in (
@@ -122,11 +127,11 @@ FILTERS: dict[str, Filter] = {
                "Dudnyk 2017, filtering with parallax mapping): the view ray towards each texel's surface point is "
                "traced with the technique's own search; a texel whose ray meets the relief first gets no weight.",
                "EWA texels + one trace per texel", _LINEAR,
-               (_MAX_TEXELS, _ALPHA), texel_loop=True, visibility=True, twin_tolerance=1e-4),
+               (_MAX_TEXELS, _ALPHA, _INHERIT), texel_loop=True, visibility=True, twin_tolerance=1e-4),
         Filter("ewa_vis_rows", "EWA with that paper's cheap visibility: each row of the ellipse is walked from one end "
                "until a hidden texel, then from the other end back until a hidden texel; the texels between are "
                "dropped without being traced.", "EWA texels + one trace per texel walked", _LINEAR,
-               (_MAX_TEXELS, _ALPHA), texel_loop=True, visibility=True, twin_tolerance=1e-4),
+               (_MAX_TEXELS, _ALPHA, _INHERIT), texel_loop=True, visibility=True, twin_tolerance=1e-4),
     )
 }
 

@@ -18,6 +18,9 @@
 // every texel; the rows method (the cheap one of Romanyuk & Dudnyk 2017) walks each row from its left end until a
 // hidden texel, then from its right end back until a hidden texel, and drops the texels between without testing
 // them. A level whose texels are all hidden falls back to the bilinear value at the hit, which is visible.
+// Weighting of a hidden texel (the visibility filters' `inherit`): dropped, or inherited by its substitute (the
+// level's texel whose cell holds the point where the texel's ray meets the relief) when that substitute lies
+// outside the ellipse; one inside is a texel of the footprint, which the walk itself counts or drops, once.
 // #include "common/ellipse.wgsl"
 // #include "common/wrap.wgsl"
 
@@ -65,21 +68,44 @@ struct EwaSum {
     budget: u32,   // max_texels: most texels visited per lookup
 }
 
-// Texel (i, j) of level e: its weight added to `acc` unless it is hidden (returns true then) or outside.
-fn ewa_take(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, i: i32, j: i32, visibility: bool,
+// Q of texel (i, j) of level e: inside the ellipse below 1.
+fn ewa_q(e: EwaLevel, texel: vec2i) -> f32 {
+    let d = vec2f(texel) - e.centre;
+    return e.a * d.x * d.x + e.b * d.x * d.y + e.c * d.y * d.y;
+}
+
+// Weight w of a hidden texel whose ray meets the relief at `occluder` (uv), inherited by its substitute: the
+// texel of level e whose cell holds that point, unless it lies inside the ellipse (a footprint texel: the walk
+// counts it with its own weight or drops it).
+fn ewa_substitute(tex: texture_2d<f32>, e: EwaLevel, occluder: vec2f, w: f32, acc: ptr<function, EwaSum>) {
+    let texel = vec2i(floor(occluder * vec2f(e.size)));
+    if ewa_q(e, texel) < 1.0 {
+        return;
+    }
+    (*acc).value += w * textureLoad(tex, wrap_texel(texel, e.size), e.level);
+    (*acc).weight += w;
+    (*acc).texels += 1u;
+}
+
+// Texel (i, j) of level e: its weight added to `acc` unless it is hidden (returns true then; with `inherit` the
+// weight goes to its substitute) or outside.
+fn ewa_take(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, i: i32, j: i32, visibility: bool, inherit: bool,
             acc: ptr<function, EwaSum>) -> bool {
-    let d = vec2f(f32(i), f32(j)) - e.centre;
-    let q = e.a * d.x * d.x + e.b * d.x * d.y + e.c * d.y * d.y;
+    let q = ewa_q(e, vec2i(i, j));
     if q >= 1.0 {
         return false;  // a row end just outside (rounding)
     }
     (*acc).visited += 1u;
-    if visibility && texel_hidden((vec2f(f32(i), f32(j)) + 0.5) / vec2f(e.size), fp) {
-        filter_stats.hidden += 1u;
-        return true;
-    }
     let alpha = ewa_alpha();
     let w = exp(-alpha * q) - exp(-alpha);
+    var occluder = vec2f(0.0);
+    if visibility && texel_hidden((vec2f(f32(i), f32(j)) + 0.5) / vec2f(e.size), fp, &occluder) {
+        filter_stats.hidden += 1u;
+        if inherit {
+            ewa_substitute(tex, e, occluder, w, acc);
+        }
+        return true;
+    }
     (*acc).value += w * textureLoad(tex, wrap_texel(vec2i(i, j), e.size), e.level);
     (*acc).weight += w;
     (*acc).texels += 1u;
@@ -103,8 +129,9 @@ fn ewa_result(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, acc: ptr<functio
     return (*acc).value / (*acc).weight;
 }
 
-// The weighted average over level e; rows: Romanyuk & Dudnyk 2017's row-ends method (visibility filters only).
-fn ewa_average(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, visibility: bool, rows: bool,
+// The weighted average over level e; rows: Romanyuk & Dudnyk 2017's row-ends method, inherit: hidden texels'
+// weights go to their substitutes (both for the visibility filters only).
+fn ewa_average(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, visibility: bool, rows: bool, inherit: bool,
                acc: ptr<function, EwaSum>) -> vec4f {
     (*acc).value = vec4f(0.0);
     (*acc).weight = 0.0;
@@ -122,7 +149,7 @@ fn ewa_average(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, visibility: boo
             for (var i = i0; i <= i1 && !done; i++) {
                 if ewa_full(acc) {
                     done = true;
-                } else if ewa_take(tex, fp, e, i, j, visibility, acc) && rows {
+                } else if ewa_take(tex, fp, e, i, j, visibility, inherit, acc) && rows {
                     stop = i;
                     break;
                 }
@@ -132,7 +159,7 @@ fn ewa_average(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, visibility: boo
                 for (; back > stop && !done; back--) {
                     if ewa_full(acc) {
                         done = true;
-                    } else if ewa_take(tex, fp, e, back, j, visibility, acc) {
+                    } else if ewa_take(tex, fp, e, back, j, visibility, inherit, acc) {
                         break;
                     }
                 }
@@ -145,7 +172,7 @@ fn ewa_average(tex: texture_2d<f32>, fp: Footprint, e: EwaLevel, visibility: boo
     return ewa_result(tex, fp, e, acc);
 }
 
-fn ewa(tex: texture_2d<f32>, footprint: Footprint, visibility: bool, rows: bool) -> vec4f {
+fn ewa(tex: texture_2d<f32>, footprint: Footprint, visibility: bool, rows: bool, inherit: bool) -> vec4f {
     let size0 = vec2f(textureDimensions(tex, 0));
     let fp = loop_footprint(footprint, size0);
     let axes = footprint_axes(fp.dx * size0, fp.dy * size0);
@@ -167,9 +194,10 @@ fn ewa(tex: texture_2d<f32>, footprint: Footprint, visibility: bool, rows: bool)
         frac = 0.0;
         filter_stats.flags |= FLAG_CAPPED;
     }
-    var value = ewa_average(tex, fp, ewa_level(tex, fp, level), visibility, rows, &acc);
+    var value = ewa_average(tex, fp, ewa_level(tex, fp, level), visibility, rows, inherit, &acc);
     if frac > 0.0 && level < top {
-        value = mix(value, ewa_average(tex, fp, ewa_level(tex, fp, level + 1), visibility, rows, &acc), frac);
+        let next = ewa_average(tex, fp, ewa_level(tex, fp, level + 1), visibility, rows, inherit, &acc);
+        value = mix(value, next, frac);
     }
     filter_stats.texels += acc.texels;
     return value;

@@ -2,5 +2,5 @@
 // #include "common/ewa.wgsl"
 
 fn filter_texture(tex: texture_2d<f32>, fp: Footprint) -> vec4f {
-    return ewa(tex, fp, false, false);
+    return ewa(tex, fp, false, false, false);
 }

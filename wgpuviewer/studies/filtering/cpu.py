@@ -51,6 +51,8 @@ class Filtered:
     flags: int = 0
     #: level -> texel (i, j) -> weight given (EWA family; 0 for texels found hidden; untested ones are absent)
     weights: dict | None = None
+    #: level -> substitute texel (i, j) -> weight it inherited from hidden texels (visibility filters, inherit 1)
+    substitutes: dict | None = None
 
 
 def _sanitized(uv, dx, dy, flags: list[int]):
@@ -165,13 +167,15 @@ def _ewa_level(levels, uv, dx, dy, level: int, alpha: float) -> _Level:
     return _Level(level, size, uv * size - 0.5, a / f, float(b) / f, c / f, np.sqrt([c, a]), np.pi * np.sqrt(f))
 
 
-#: hidden(uv (M, 2)) -> (M,) bool: which texel centres the relief hides from the pixel.
-HiddenTest = Callable[[np.ndarray], np.ndarray]
+#: hidden(uv (M, 2)) -> Visibility of those texel centres: which the relief hides from the pixel, and where their
+#: rays meet it.
+HiddenTest = Callable[[np.ndarray], "Visibility"]
 
 
 def ewa(levels, uv, dx, dy, *, max_texels: int = 256, alpha: float = 2.0, hidden: HiddenTest | None = None,
-        rows: bool = False) -> Filtered:
-    """EWA as wgsl/common/ewa.wgsl computes it; ``hidden`` makes it ewa_vis (ewa_vis_rows with ``rows``)."""
+        rows: bool = False, inherit: bool = False) -> Filtered:
+    """EWA as wgsl/common/ewa.wgsl computes it; ``hidden`` makes it ewa_vis (ewa_vis_rows with ``rows``), whose
+    hidden texels' weights are dropped or, with ``inherit``, passed to their substitutes outside the ellipse."""
     flags = [0]
     uv, dx, dy = _sanitized(uv, dx, dy, flags)
     size0 = _size(levels[0])
@@ -191,26 +195,46 @@ def ewa(levels, uv, dx, dy, *, max_texels: int = 256, alpha: float = 2.0, hidden
             break
         level, frac = level + 1, 0.0
         flags[0] |= FLAGS["capped"]
-    state = {"visited": 0, "texels": 0, "hidden": 0, "weights": {}}
-    value = _ewa_average(levels, uv, _ewa_level(levels, uv, dx, dy, level, alpha), max_texels, alpha, hidden, rows,
-                         state, flags)
+    state = {"visited": 0, "texels": 0, "hidden": 0, "weights": {}, "substitutes": {}}
+    walk = {"budget": max_texels, "alpha": alpha, "hidden": hidden, "rows": rows, "inherit": inherit}
+    value = _ewa_average(levels, uv, _ewa_level(levels, uv, dx, dy, level, alpha), state, flags, **walk)
     if frac > 0.0 and level < top:
-        other = _ewa_average(levels, uv, _ewa_level(levels, uv, dx, dy, level + 1, alpha), max_texels, alpha, hidden,
-                             rows, state, flags)
+        other = _ewa_average(levels, uv, _ewa_level(levels, uv, dx, dy, level + 1, alpha), state, flags, **walk)
         value = value + frac * (other - value)
-    return Filtered(value, state["texels"], state["hidden"], flags[0], state["weights"])
+    return Filtered(value, state["texels"], state["hidden"], flags[0], state["weights"], state["substitutes"])
 
 
-def _ewa_average(levels, uv, e: _Level, budget: int, alpha: float, hidden, rows: bool, state, flags) -> np.ndarray:
+def substitute_texel(e: _Level, occluder) -> tuple[int, int]:
+    """The texel of level ``e`` whose cell holds the uv ``occluder`` (where a hidden texel's ray meets the relief)."""
+    i, j = np.floor(np.asarray(occluder, np.float64) * e.size)
+    return int(i), int(j)
+
+
+def _ewa_average(levels, uv, e: _Level, state, flags, *, budget: int, alpha: float, hidden, rows: bool,
+                 inherit: bool) -> np.ndarray:
     texture = levels[e.level]
     h, w = texture.shape[:2]
     inside = [(i, j) for j, i0, i1 in e.rows() for i in range(i0, i1 + 1) if e.q(i, j) < 1.0]
-    is_hidden = {}
+    is_hidden, occluders = {}, {}
     if hidden is not None and inside:
-        verdicts = hidden(np.array([e.texel_uv(i, j) for i, j in inside]))
-        is_hidden = dict(zip(inside, np.asarray(verdicts, bool)))
+        seen = hidden(np.array([e.texel_uv(i, j) for i, j in inside]))
+        is_hidden = dict(zip(inside, np.asarray(seen.hidden, bool)))
+        occluders = dict(zip(inside, seen.hit))
     acc, weight = np.zeros(texture.shape[2]), 0.0
     weights = state["weights"].setdefault(e.level, {})
+    substitutes = state["substitutes"].setdefault(e.level, {})
+
+    def substitute(occluder, wt: float) -> None:
+        """wgsl/common/ewa.wgsl's ewa_substitute: the weight goes to the texel whose cell holds the occluder,
+        unless that texel lies inside the ellipse (the walk counts or drops it)."""
+        nonlocal acc, weight
+        i, j = substitute_texel(e, occluder)
+        if e.q(i, j) < 1.0:
+            return
+        acc = acc + wt * texture[j % h, i % w]
+        weight += wt
+        substitutes[(i, j)] = substitutes.get((i, j), 0.0) + wt
+        state["texels"] += 1
 
     def take(i: int, j: int) -> bool:
         nonlocal acc, weight
@@ -218,11 +242,13 @@ def _ewa_average(levels, uv, e: _Level, budget: int, alpha: float, hidden, rows:
         if q >= 1.0:
             return False
         state["visited"] += 1
+        wt = np.exp(-alpha * q) - np.exp(-alpha)
         if is_hidden.get((i, j), False):
             state["hidden"] += 1
             weights[(i, j)] = weights.get((i, j), 0.0)
+            if inherit:
+                substitute(occluders[(i, j)], wt)
             return True
-        wt = np.exp(-alpha * q) - np.exp(-alpha)
         acc = acc + wt * texture[j % h, i % w]
         weight += wt
         weights[(i, j)] = weights.get((i, j), 0.0) + wt
@@ -264,11 +290,12 @@ class Visibility:
 
     hidden: np.ndarray  # (M,) bool: the ray towards the texel meets the relief more than VIS_TOLERANCE before it
     margin: np.ndarray  # (M,) float64: D(uv) - t* (layer depth the ray is short of the texel; ~0 when visible)
+    hit: np.ndarray  # (M, 2) float64: where that ray first meets the relief (not wrapped; NaN where declined)
 
 
 def texel_visibility(depth: np.ndarray, uv: np.ndarray, view_dir, height_scale: float) -> Visibility:
     """wgsl/visibility/traced.wgsl in float64: the ray reaching (uv, D(uv)) enters at uv + D P; hidden when its
-    exact first hit t* < D - VIS_TOLERANCE."""
+    exact first hit t* < D - VIS_TOLERANCE; that hit is the hidden texel's occluder."""
     from wgpuviewer.relief.reference import sample_bilinear
 
     uv = np.atleast_2d(np.asarray(uv, np.float64))
@@ -277,11 +304,12 @@ def texel_visibility(depth: np.ndarray, uv: np.ndarray, view_dir, height_scale: 
     span = v[:2] / max(v[2], 1e-4) * height_scale
     hit = exact_hit(depth, uv + d[:, None] * span, v, height_scale)
     margin = np.where(hit.valid, d - hit.t, 0.0)
-    return Visibility(margin > VIS_TOLERANCE, margin)
+    return Visibility(margin > VIS_TOLERANCE, margin, hit.uv)
 
 
 def hidden_test(depth: np.ndarray, view_dir, height_scale: float) -> HiddenTest:
-    return lambda uv: texel_visibility(depth, uv, view_dir, height_scale).hidden
+    """The visibility filters' test of texel centres on ``depth`` seen along ``view_dir`` (texel_visibility)."""
+    return lambda uv: texel_visibility(depth, uv, view_dir, height_scale)
 
 
 def cpu_filter(name: str, levels, uv, dx, dy, *, params: dict | None = None, hidden: HiddenTest | None = None) -> Filtered:
@@ -296,5 +324,6 @@ def cpu_filter(name: str, levels, uv, dx, dy, *, params: dict | None = None, hid
         return ewa_approx(levels, uv, dx, dy, p["max_probes"], p["alpha"])
     if f.texel_loop:
         return ewa(levels, uv, dx, dy, max_texels=p["max_texels"], alpha=p["alpha"],
-                   hidden=hidden if f.visibility else None, rows=name == "ewa_vis_rows")
+                   hidden=hidden if f.visibility else None, rows=name == "ewa_vis_rows",
+                   inherit=bool(p.get("inherit", 0)))
     return None
