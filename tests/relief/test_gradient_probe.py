@@ -8,6 +8,7 @@ import pytest
 
 from wgpuviewer.relief import filter_probe
 from wgpuviewer.relief.filter_probe import (
+    SAMPLER_KINDS,
     GradientProbe,
     explicit_gradient_note,
     explicit_gradient_probe,
@@ -40,6 +41,16 @@ def test_the_decision_names_what_is_ignored(sampler, pair, value, phrase):
     assert len(ignored) == 1 and ignored[0].startswith(phrase), ignored
 
 
+def test_the_decision_per_sampler():
+    reads = dict(HONOURED_ANISO, thin=0.5)
+    assert ignored_gradients(HONOURED_ISO, reads, "isotropic") == []
+    assert len(ignored_gradients(HONOURED_ISO, reads, "anisotropic")) == 1
+    probe = GradientProbe("a GPU", HONOURED_ISO, reads)
+    assert probe.honoured_by("isotropic") and not probe.honoured_by("anisotropic") and not probe.honoured
+    with pytest.raises(ValueError, match="sampler = 'linear'"):
+        ignored_gradients(HONOURED_ISO, reads, "linear")
+
+
 def test_the_decision_refuses_equal_reads():
     """An adapter that reads one value whatever the gradients (lavapipe's anisotropic sampler) honours nothing."""
     same = dict.fromkeys(HONOURED_ISO, 0.82)
@@ -67,8 +78,14 @@ def test_probe_on_this_adapter(gpu):
     assert probe.isotropic["huge"] == pytest.approx(0.5, abs=0.02)
     note = explicit_gradient_note(gpu)
     assert (note == "") == explicit_gradient_support(gpu)
+    for kind in SAMPLER_KINDS:
+        assert explicit_gradient_support(gpu, kind) == probe.honoured_by(kind)
+        assert (explicit_gradient_note(gpu, kind) == "") == probe.honoured_by(kind)
     if "llvmpipe" in gpu.summary:
         aniso = probe.anisotropic
         assert aniso["tiny"] == aniso["huge"] == aniso["thin"] == aniso["round"]
-        assert not explicit_gradient_support(gpu)
-        assert note.startswith(gpu.summary) and "aniso" in note
+        assert not explicit_gradient_support(gpu) and not explicit_gradient_support(gpu, "anisotropic")
+        assert explicit_gradient_support(gpu, "isotropic")
+        assert note == explicit_gradient_note(gpu, "anisotropic")
+        assert note.startswith(gpu.summary) and note.endswith("through an anisotropic sampler there is not measured "
+                                                              "validly.")

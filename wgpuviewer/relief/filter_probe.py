@@ -19,7 +19,7 @@ import numpy as np
 import wgpu
 
 from wgpuviewer.core.compute import Kernel, compute_for
-from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, get_gpu, mip_chain
 from wgpuviewer.core.structs import Struct
 
@@ -58,6 +58,15 @@ GRADIENT_PAIRS = {
 GRADIENT_ANISOTROPY = 16
 #: Smallest difference between two of the probe's reads that shows a level change (level 0 vs coarser: 0.5).
 GRADIENT_CONTRAST = 0.25
+#: The probe's kinds of sampler: isotropic trilinear, and anisotropic with GRADIENT_ANISOTROPY.
+SAMPLER_KINDS = ("isotropic", "anisotropic")
+#: Its checks: (sampler kind, the pair that must read level 0, the pair that must read a coarser level, what the
+#: adapter ignores when it does not).
+_GRADIENT_CHECKS = (
+    ("isotropic", "tiny", "huge", "length with an isotropic sampler"),
+    ("anisotropic", "tiny", "huge", f"length with an anisotropic sampler (max_anisotropy {GRADIENT_ANISOTROPY})"),
+    ("anisotropic", "thin", "round", "shape: through the anisotropic sampler a 16:1 pair reads a round pair's level"),
+)
 
 
 @dataclass
@@ -157,31 +166,37 @@ class GradientProbe:
     isotropic: dict[str, float]
     anisotropic: dict[str, float]
 
+    def ignored_by(self, sampler: str | None = None) -> list[str]:
+        """What the adapter ignores through ``sampler`` (a SAMPLER_KINDS entry; None: either), as phrases."""
+        return ignored_gradients(self.isotropic, self.anisotropic, sampler)
+
     @property
     def ignored(self) -> list[str]:
-        return ignored_gradients(self.isotropic, self.anisotropic)
+        return self.ignored_by()
+
+    def honoured_by(self, sampler: str | None = None) -> bool:
+        return not self.ignored_by(sampler)
 
     @property
     def honoured(self) -> bool:
-        return not self.ignored
+        return self.honoured_by()
 
 
-def ignored_gradients(isotropic: dict[str, float], anisotropic: dict[str, float]) -> list[str]:
+def ignored_gradients(isotropic: dict[str, float], anisotropic: dict[str, float],
+                      sampler: str | None = None) -> list[str]:
     """The decision of the explicit-gradient probe, from its reads (GRADIENT_PAIRS name -> value): what the
-    adapter ignores, as phrases for a sentence ([] when it honours the gradients). Honoured gradients read level 0
-    (1) at the tiny pair and a coarse level (0.5) at the huge one through both samplers, and level 0 at the 16:1
-    thin pair through the anisotropic sampler where the round pair of the same major axis reads level 4."""
-    def finer(values: dict[str, float], fine: str, coarse: str) -> bool:
-        difference = values[fine] - values[coarse]
-        return bool(np.isfinite(difference) and difference > GRADIENT_CONTRAST)
-
+    adapter ignores through ``sampler`` (a SAMPLER_KINDS entry; None: either), as phrases for a sentence ([] when
+    it honours the gradients). Honoured gradients read level 0 (1) at the tiny pair and a coarse level (0.5) at the
+    huge one through both samplers, and level 0 at the 16:1 thin pair through the anisotropic sampler where the
+    round pair of the same major axis reads level 4."""
+    if sampler is not None and sampler not in SAMPLER_KINDS:
+        raise InputError(f"sampler = {sampler!r}: expected one of {', '.join(SAMPLER_KINDS)} or None")
+    reads = {"isotropic": isotropic, "anisotropic": anisotropic}
     ignored = []
-    if not finer(isotropic, "tiny", "huge"):
-        ignored.append("length with an isotropic sampler")
-    if not finer(anisotropic, "tiny", "huge"):
-        ignored.append(f"length with an anisotropic sampler (max_anisotropy {GRADIENT_ANISOTROPY})")
-    if not finer(anisotropic, "thin", "round"):
-        ignored.append("shape: through the anisotropic sampler a 16:1 pair reads a round pair's level")
+    for kind, fine, coarse, phrase in _GRADIENT_CHECKS:
+        difference = reads[kind][fine] - reads[kind][coarse]
+        if sampler in (None, kind) and not (np.isfinite(difference) and difference > GRADIENT_CONTRAST):
+            ignored.append(phrase)
     return ignored
 
 
@@ -222,16 +237,21 @@ def _run_gradient_probe(gpu: Gpu) -> GradientProbe:
                          {n: float(v) for n, v in zip(names, out["anisotropic"])})
 
 
-def explicit_gradient_support(gpu: Gpu) -> bool:
-    """Whether ``gpu`` honours ``textureSampleGrad``'s explicit gradients, with isotropic and anisotropic samplers
-    (without, the ``aniso`` filter's footprint is not the derivative source's, and its numbers are the driver's)."""
-    return explicit_gradient_probe(gpu).honoured
+def explicit_gradient_support(gpu: Gpu, sampler: str | None = None) -> bool:
+    """Whether ``gpu`` honours ``textureSampleGrad``'s explicit gradients through ``sampler`` (a SAMPLER_KINDS
+    entry; None: both kinds). Where it does not, a filter sampling through that kind (the ``aniso`` filter: the
+    anisotropic one) is given the driver's footprint, not the derivative source's, and its numbers are the
+    driver's."""
+    return explicit_gradient_probe(gpu).honoured_by(sampler)
 
 
-def explicit_gradient_note(gpu: Gpu) -> str:
-    """One sentence for reports when ``gpu`` ignores explicit gradients ("" when it honours them)."""
+def explicit_gradient_note(gpu: Gpu, sampler: str | None = None) -> str:
+    """One sentence for reports when ``gpu`` ignores explicit gradients through ``sampler`` (None: either kind);
+    "" when it honours them."""
     probe = explicit_gradient_probe(gpu)
-    if probe.honoured:
+    ignored = probe.ignored_by(sampler)
+    if not ignored:
         return ""
-    return (f"{probe.adapter} ignores textureSampleGrad's explicit gradients ({'; '.join(probe.ignored)}), so "
-            "the hardware `aniso` filter cannot be measured validly on it.")
+    kinds = [kind for kind in SAMPLER_KINDS if sampler in (None, kind) and not probe.honoured_by(kind)]
+    return (f"{gpu.summary} ignores textureSampleGrad's explicit gradients ({'; '.join(ignored)}): a filter "
+            f"sampling through {' or '.join(f'an {k}' for k in kinds)} sampler there is not measured validly.")
