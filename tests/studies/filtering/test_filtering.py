@@ -10,13 +10,16 @@ import numpy as np
 import pytest
 
 from wgpuviewer.cli import main
+from wgpuviewer.relief.filter_probe import explicit_gradient_probe, explicit_gradient_support
 from wgpuviewer.relief.filters import DERIVATIVE_LIMIT, FILTERS, FLAGS
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.studies.filtering import supersample as ss
-from wgpuviewer.studies.filtering.run import psnr
-from wgpuviewer.studies.filtering.suites import TABLE, Config
-from wgpuviewer.studies.filtering.views import HEIGHT_SCALE, TEXTURE_SIZE, Case, depth_map, make_view
+from wgpuviewer.studies.filtering.report import place_labels
+from wgpuviewer.studies.filtering.run import flicker_psnr, flicker_ratio, psnr, psnr_uncertainty, unresolved, void_reason
+from wgpuviewer.studies.filtering.suites import EXPLICIT_GRADIENTS, TABLE, TUNING_CONFIGS, Config, inherit_available
+from wgpuviewer.studies.filtering.views import HEIGHT_SCALE, MASK_LEVEL, TEXTURE_SIZE, Case, albedo_image, depth_map, make_view
+from wgpuviewer.textures import builtin_height
 
 SIZE = (32, 24)
 GOLDEN_SCENE = Path(__file__).resolve().parents[2] / "relief" / "golden" / "scene.toml"  # small textures
@@ -137,6 +140,84 @@ def test_gaussian_average_is_a_normalised_symmetric_kernel():
     assert np.allclose(out[1, 1:3, 0], [1.5, 2.5])
 
 
+def test_masked_albedo_is_a_fine_checker_exactly_on_the_low_parts():
+    for relief in ("bricks", "step"):
+        image = albedo_image("masked", relief=relief)
+        low = builtin_height(relief, (TEXTURE_SIZE, TEXTURE_SIZE)) < MASK_LEVEL
+        assert 0.05 < low.mean() < 0.95
+        grey = image[..., 0]
+        # low parts alternate dark and bright from texel to texel; high parts are one colour
+        assert np.abs(np.diff(grey, axis=1))[(low[:, 1:] & low[:, :-1])].min() > 0.5
+        assert np.ptp(image[~low].reshape(-1, 3), axis=0).max() == 0.0
+
+
+def test_shifted_view_slides_the_picture_by_the_asked_texels(folder):
+    view = make_view(Case("bricks", "checker", 80.0, 2.0), SIZE, folder)
+    uv0, v0 = view.entries(1)
+    uv1, v1 = view.shifted(0.37).entries(1)
+    moved = np.linalg.norm(uv1 - uv0, axis=-1) * TEXTURE_SIZE
+    assert np.allclose(moved, 0.37, rtol=1e-6) and np.allclose(v0, v1, atol=1e-12)
+
+
+def test_explicit_gradient_filters_are_the_ones_whose_wgsl_samples_with_gradients():
+    """The void rule's list of filters is the filters' own WGSL: the ones calling textureSampleGrad, with the
+    anisotropic kind exactly for a sampler with max_anisotropy."""
+    wgsl = Path(__file__).resolve().parents[3] / "wgsl" / "filters"
+    calling = {name for name in FILTERS if "textureSampleGrad" in (wgsl / f"{name}.wgsl").read_text()}
+    assert calling == set(EXPLICIT_GRADIENTS)
+    for name, kind in EXPLICIT_GRADIENTS.items():
+        assert (kind == "anisotropic") == any(p.name == "max_anisotropy" for p in FILTERS[name].params)
+
+
+def test_void_rows_follow_the_gradient_probe(gpu):
+    ignored = explicit_gradient_probe(gpu).ignored
+    aniso = void_reason(Config("aniso", "analytic", (("max_anisotropy", 16),)), gpu)
+    assert bool(aniso) == any("anisotropic" in p for p in ignored)
+    trilinear = void_reason(Config("trilinear", "displaced"), gpu)
+    assert bool(trilinear) == any("anisotropic" not in p for p in ignored)
+    assert void_reason(Config("ewa", "analytic"), gpu) == "" and void_reason(Config("bilinear"), gpu) == ""
+
+
+def test_flicker_measures_change_against_the_reference_change():
+    rng = np.random.default_rng(1)
+    reference = rng.uniform(size=(5, 6, 8, 3))
+    mask = np.ones((6, 8), bool)
+    assert flicker_psnr(reference, reference, mask) == 99.0 and flicker_ratio(reference, reference, mask) == 1.0
+    frozen = np.repeat(reference[:1], 5, axis=0)  # a filter that smears all motion away
+    assert flicker_ratio(frozen, reference, mask) == 0.0
+    shimmer = reference + rng.normal(0, 0.2, reference.shape)  # the true motion plus per-frame noise
+    assert flicker_ratio(shimmer, reference, mask) > 1.0 and flicker_psnr(shimmer, reference, mask) < 20.0
+    offset = reference + 0.3  # a constant error does not flicker
+    assert flicker_psnr(offset, reference, mask) > 90.0
+
+
+def test_reference_uncertainty_bounds_and_decides_which_differences_are_resolved():
+    assert psnr_uncertainty(30.0, 0.0) == 0.0
+    # RMS error 10^-1.5; a reference error of the same size can double it: 20 log10(2) dB
+    assert psnr_uncertainty(30.0, 10 ** -1.5) == pytest.approx(20 * np.log10(2.0))
+
+    def row(label, value, u):
+        return {"label": label, "tracer": "maxmip", "psnr": value, "psnr_uncertainty": u, "void": ""}
+
+    rows = [row("ewa (displaced)", 30.0, 0.2), row("ewa_vis (displaced)", 30.3, 0.2),
+            row("ewa (analytic)", 32.0, 0.01), row("trilinear (uv)", 25.0, 0.01), row("bilinear (uv)", 31.95, 0.01)]
+    assert unresolved(rows) == [("ewa_vis (displaced)", "ewa (displaced)")]  # 0.3 dB within 0.4; 0.05 is "equal"
+    rows[1]["psnr"] = 30.5
+    assert unresolved(rows) == []
+
+
+def test_pareto_labels_do_not_overlap():
+    rng = np.random.default_rng(2)
+    points = [tuple(p) for p in rng.uniform(0, 100, (30, 2))] + [(50.0, 50.0)] * 5  # a crowd, some on one spot
+    widths = list(rng.uniform(40, 120, len(points)))
+    offsets = place_labels(points, widths, 8.0, 5.0, marker=3.0)
+    boxes = [(px + dx, py + dy - 4, px + dx + w, py + dy + 4) for (px, py), w, (dx, dy) in zip(points, widths, offsets)]
+    markers = [(px - 3, py - 3, px + 3, py + 3) for px, py in points]
+    for i, a in enumerate(boxes):
+        for b in boxes[:i] + markers:
+            assert a[2] <= b[0] or a[0] >= b[2] or a[3] <= b[1] or a[1] >= b[3], (a, b)
+
+
 # --- CLI and the smoke suite ---------------------------------------------------------------------------------
 
 
@@ -176,30 +257,54 @@ def test_render_with_a_filter(tmp_path, adapter):
     assert a.shape == b.shape == (36, 64, 3) and 0.1 < np.abs(a - b).mean() < 30
 
 
-def test_smoke_suite_end_to_end(tmp_path, adapter):
+def test_smoke_suite_end_to_end(tmp_path, gpu):
     out = tmp_path / "smoke"
     assert main(["filtering", "--out", str(out), "--suite", "smoke", "--quiet"]) == 0
     rows = TABLE.read(out / "results.csv")
-    assert {"filter", "derivatives", "psnr", "ssim", "psnr_gauss", "psnr_occluded", "time_ratio",
-            "texels_per_pixel", "capped_share"} <= set(rows[0])
+    assert {"filter", "derivatives", "tracer", "role", "void", "psnr", "ssim", "psnr_gauss", "psnr_occluded",
+            "psnr_uncertainty", "time_ratio", "texels_per_pixel", "capped_share", "reference_rays",
+            "reference_resolved", "flicker_psnr", "flicker_ratio"} <= set(rows[0])
     labels = {r["label"] for r in rows}
-    assert {"trilinear (uv)", "aniso 16 (uv)", "ewa (displaced)", "ewa_vis (displaced)",
-            "ewa_vis_rows (displaced)"} <= labels
+    assert {"trilinear (uv)", "bilinear (uv)", "aniso 16 (uv)", "ewa (displaced)", "ewa_vis (displaced)",
+            "ewa_vis_rows (displaced)", "trilinear (uv) [pom32]", "ewa_vis (displaced) [pom32]"} <= labels
+    if inherit_available():
+        assert "ewa_vis inherit=1 (displaced)" in labels
+    probe_honours = explicit_gradient_support(gpu)
     for r in rows:
         assert np.isfinite(r["psnr"]) and 0.0 < r["ssim"] <= 1.0 and r["time_ratio"] > 0 and r["pixels"] > 0
-        if r["label"] == "trilinear (uv)":
-            assert r["time_ratio"] == 1.0
+        assert r["psnr_uncertainty"] >= 0.0 and r["reference_rays"] == 16
+        if r["label"] in ("trilinear (uv)", "trilinear (uv) [pom32]"):
+            assert r["time_ratio"] == 1.0  # each tracer's own baseline
+        assert bool(r["void"]) == (r["filter"] == "aniso" and not probe_honours), r
     by = {(r["case"], r["label"]): r for r in rows}
     flat = [c for c, label in by if c.startswith("flat0") and label == "ewa (displaced)"]
     for case in flat:  # nothing is hidden on a flat relief: visibility changes nothing
         assert by[case, "ewa_vis (displaced)"]["psnr"] == by[case, "ewa (displaced)"]["psnr"]
         assert by[case, "ewa_vis (displaced)"]["hidden_per_pixel"] == 0.0
-    occluding = [r for r in rows if r["occluding"] is True and r["label"] == "ewa_vis (displaced)"]
+    occluding = [r for r in rows if r["occluding"] is True and r["label"] == "ewa_vis (displaced)" and r["role"] == "rank"]
     assert occluding and all(r["hidden_per_pixel"] > 0 and r["occluded_share"] > 0 for r in occluding)
+    # the flicker sweep: the 80-degree cases at x2, every valid configuration; none elsewhere
+    swept = [r for r in rows if r["role"] == "rank" and not r["void"] and r["angle"] == 80.0]
+    assert swept and all(np.isfinite(r["flicker_psnr"]) and r["flicker_ratio"] > 0 for r in swept)
+    assert all(np.isnan(r["flicker_psnr"]) for r in rows if r["angle"] != 80.0 or r["void"] or r["role"] == "tune")
+    tune = [r for r in rows if r["role"] == "tune"]
+    assert {r["label"] for r in tune} == {c.label for c in TUNING_CONFIGS}
+    assert not {r["case"] for r in tune} & {r["case"] for r in rows if r["role"] == "rank"}
     report = (out / "report.md").read_text()
     assert report.startswith("# Texture filtering on relief surfaces (Romanyuk & Dudnyk 2017)\n\n- command: "
                              f"`wgpuviewer filtering --out {out} --suite smoke --quiet`\n- adapter: **{rows[0]['adapter']}**")
-    assert "## The answer" in report and "pareto.png" in report and "crops_" in report
-    assert (out / "pareto.png").stat().st_size > 10_000
+    for section in ("## Recommendation", "## Visibility", "## Flicker", "## Tuning", "## Per case"):
+        assert section in report, section
+    assert "pareto.png" in report and "distributions.png" in report and "crops_" in report
+    if not probe_honours:
+        assert "**Void rows**" in report and "`aniso 16 (uv)`" in report
+    assert (out / "pareto.png").stat().st_size > 10_000 and (out / "distributions.png").stat().st_size > 10_000
     crops = list(out.glob("crops_*.png"))
     assert crops and all(p.stat().st_size > 5_000 for p in crops)
+    # the report again from results.csv and run.json, measuring nothing: the same text
+    again = tmp_path / "again"
+    again.mkdir()
+    for crop in crops:
+        (again / crop.name).write_bytes(crop.read_bytes())
+    assert main(["filtering", "--out", str(again), "--from-csv", str(out / "results.csv"), "--quiet"]) == 0
+    assert (again / "report.md").read_text() == report

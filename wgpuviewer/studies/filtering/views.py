@@ -13,6 +13,7 @@ technique, so the filters are compared on the true hits.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,13 +33,19 @@ TECHNIQUE = "maxmip"  # exact first hits (to float32) for the filters and the re
 
 #: Reliefs: builtin height maps; flat0 is a flat relief (every ray reaches the floor, nothing is hidden).
 RELIEFS = {"bricks": "bricks (occlusion at the mortar)", "step": "one 0-to-1 step per tile (occlusion behind it)",
-           "wall": "a one-texel wall per tile", "flat0": "flat (depth 1: displaced, nothing hidden)"}
-OCCLUDING = ("bricks", "step", "wall")
+           "wall": "a one-texel wall per tile", "flat0": "flat (depth 1: displaced, nothing hidden)",
+           "bumps": "smooth bumps (occlusion behind their crests at grazing views; the tuning cases' relief)"}
+OCCLUDING = ("bricks", "step", "wall", "bumps")
 #: High-frequency albedos (sRGB PNGs written into the study's folder).
 #: "own": the relief builtin's own albedo, whose colour follows the height (mortar vs brick, low vs high side of a
 #: step): there the hidden texels differ from the visible ones, the case the filtering paper is about.
 ALBEDOS = {"checker": "2-texel checker (period 4 texels)", "stripes": "stripes, period 3 texels, 20 degrees off u",
-           "photo": "scikit-image astronaut photograph, 256x256", "own": "the relief builtin's own albedo"}
+           "photo": "scikit-image astronaut photograph, 256x256", "own": "the relief builtin's own albedo",
+           "masked": "a 1-texel checker on the relief's low parts (height below 1/2: the mortar, the low side of a "
+                     "step), a flat brick red on the high parts"}
+#: Albedos made from the relief's height (a file per relief).
+RELIEF_ALBEDOS = ("masked",)
+MASK_LEVEL = 0.5  # "masked": height below this is a low part
 
 
 @dataclass(frozen=True)
@@ -57,9 +64,15 @@ class Case:
         return self.relief in OCCLUDING
 
 
-def albedo_image(name: str, size: int = TEXTURE_SIZE) -> np.ndarray:
-    """(size, size, 3) sRGB-encoded albedo in [0, 1] (what the PNG holds)."""
+def albedo_image(name: str, size: int = TEXTURE_SIZE, relief: str = "") -> np.ndarray:
+    """(size, size, 3) sRGB-encoded albedo in [0, 1] (what the PNG holds); ``relief`` for the RELIEF_ALBEDOS."""
     j, i = np.indices((size, size))
+    if name == "masked":
+        # High frequencies exactly where the relief hides texels at grazing views: the hidden texels differ from
+        # the visible ones in detail as well as in colour, unlike "own" (smooth) and the relief-blind albedos.
+        low = textures.builtin_height(relief, (size, size)) < MASK_LEVEL
+        fine = np.where((i + j) % 2, 0.9, 0.08)[..., None] * np.array([1.0, 0.95, 0.85])
+        return np.where(low[..., None], fine, np.array([0.62, 0.25, 0.18]))
     if name == "checker":
         grey = np.where((i // 2 + j // 2) % 2, 0.85, 0.15)
         return np.repeat(grey[..., None], 3, axis=2)
@@ -78,14 +91,14 @@ def albedo_image(name: str, size: int = TEXTURE_SIZE) -> np.ndarray:
     raise UserError(f"albedo {name!r}: unknown; expected one of {', '.join(ALBEDOS)}")
 
 
-def write_albedo(name: str, folder: Path) -> Path:
-    """The albedo as an 8-bit sRGB PNG in ``folder`` (written once)."""
+def write_albedo(name: str, folder: Path, relief: str = "") -> Path:
+    """The albedo as an 8-bit sRGB PNG in ``folder`` (written once; one per relief for the RELIEF_ALBEDOS)."""
     import cv2
 
-    path = Path(folder) / f"albedo_{name}.png"
+    path = Path(folder) / (f"albedo_{name}_{relief}.png" if name in RELIEF_ALBEDOS else f"albedo_{name}.png")
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
-        rgb = np.rint(albedo_image(name) * 255).astype(np.uint8)
+        rgb = np.rint(albedo_image(name, relief=relief) * 255).astype(np.uint8)
         if not cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
             raise UserError(f"{path}: could not write the albedo texture")
     return path
@@ -127,6 +140,16 @@ class View:
         to_eye = -d @ self.rotation
         return uv, np.stack([to_eye[..., 0], to_eye[..., 2], to_eye[..., 1]], -1)
 
+    def shifted(self, texels: float) -> View:
+        """The same view with the camera (and its target) moved ``texels`` texels along the frame's x axis, parallel
+        to the plane: the picture slides over the relief by that much (the flicker sweep's frames)."""
+        step = texels / (TEXTURE_SIZE * self.uv_scale[0] / self.plane_size[0])  # world units
+        move = np.array([step, 0.0, 0.0])  # world X lies in the plane and along the frame's x at every angle
+        c = self.camera
+        camera = dataclasses.replace(c, position=tuple(float(x) for x in np.asarray(c.position) + move),
+                                     target=tuple(float(x) for x in np.asarray(c.target) + move))
+        return dataclasses.replace(self, camera=camera)
+
 
 def make_view(case: Case, size: tuple[int, int], folder: Path) -> View:
     if not 0.0 <= case.angle <= 90.0 - 2 * HORIZON_MARGIN:
@@ -159,7 +182,7 @@ def make_view(case: Case, size: tuple[int, int], folder: Path) -> View:
     if case.albedo == "own":
         albedo = f'{{ builtin = "{case.relief}", size = [{TEXTURE_SIZE}, {TEXTURE_SIZE}] }}'
     else:
-        albedo = _toml_path(write_albedo(case.albedo, folder))
+        albedo = _toml_path(write_albedo(case.albedo, folder, case.relief))
     text = SCENE.format(name=case.name, eye=_vec(eye), up=_vec(camera.up), fov=fov, albedo=albedo,
                         relief=case.relief, texels=TEXTURE_SIZE, scale=HEIGHT_SCALE, uv_scale=uv_scale, size=extent,
                         azimuth=AZIMUTH, technique=TECHNIQUE)
