@@ -72,8 +72,9 @@ def _compare(name, texture, uv, dx, dy, view, height):
 @pytest.mark.parametrize("name", VISIBILITY)
 @pytest.mark.parametrize("relief", ["bricks", "step", "wall"])
 def test_inherit_equals_its_float64_twin(gpu, name, relief):
-    """Random footprints (magnification to 60 texels per pixel, eccentricities to 50) on occluding reliefs at 60
-    and 85 degrees: the same texels read (visible ones and substitutes), the same hidden count, the same value."""
+    """Random footprints (0.05 to 60 texels per pixel, eccentricities to 50, uv outside [0, 1)) on occluding
+    reliefs at 60 and 85 degrees: the same texels read (visible ones and substitutes), the same hidden count and
+    flags, the same value."""
     texture = textures()["noise 64x48"]
     height = builtin_height(relief, (64, 48))
     inherited = 0

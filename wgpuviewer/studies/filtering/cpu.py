@@ -1,9 +1,10 @@
 """Float64 twins of the texture filters (``wgsl/filters/``, ``wgsl/common/ellipse.wgsl``, ``common/ewa.wgsl``) and
 of the visibility test (``wgsl/visibility/traced.wgsl``), for the tests that hold the GPU to them.
 
-Everything follows the WGSL step by step (same level choice, texel cap, walk order, row-ends method, fallbacks), in
-float64, on the float16-rounded mip chain the GPU holds (``relief.filter_probe.texture_levels``). The visibility
-test uses the float64 exact hit (``relief.reference.exact_hit``) where the GPU uses the technique's own trace.
+Everything follows the WGSL step by step (same level choice, texel cap, walk order, row-ends method, hidden texels'
+weights dropped or inherited by their substitutes, fallbacks), in float64, on the float16-rounded mip chain the GPU
+holds (``relief.filter_probe.texture_levels``). The visibility test uses the float64 exact hit
+(``relief.reference.exact_hit``) where the GPU uses the technique's own trace.
 """
 
 from __future__ import annotations
