@@ -528,6 +528,7 @@ def markdown(rows: list[dict], record: dict, pictures: list[str], pareto: str | 
                           f"{sweep['step']} texel per frame, reference {sweep['rays']}x{sweep['rays']}, at "
                           f"{', '.join(f'{a:g}°' for a in sweep['angles'])} and "
                           f"{', '.join(f'x{f:g}' for f in sweep['footprints'])}" if sweep else "no flicker sweep"),
+        *([f"- **{record['stopped']}**: this report covers only those"] if record.get("stopped") else []),
         "",
         f"Technique `{TECHNIQUE}` (exact hits) for the reference and the rows without a tracer tag; `[pom32]`: the "
         f"same after POM with 32 layers. Relief depth {HEIGHT_SCALE} UV units per tile; errors of the unlit, filtered "

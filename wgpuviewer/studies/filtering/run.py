@@ -224,6 +224,9 @@ def measure_flicker(case: Case, suite: Suite, configs, gpu, folder: Path, progre
 
 
 def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
+    """Measure the suite into ``out``: the tuning cases, then every case (with its flicker sweep where the suite
+    asks for one). results.csv and run.json are written after every case, so a run stopped by Ctrl-C or SIGTERM
+    (``./dev gpu-suite``'s time box) keeps the cases it finished and reports on them before it stops."""
     from tqdm import tqdm
 
     from . import report
@@ -233,38 +236,50 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     gpu = get_gpu(options.backend)
     textures = out / "textures"
     void = {c: void_reason(c, gpu) for c in (*suite.configs, *suite.tuning_configs)}
+    notes = sorted({v for v in void.values() if v})
     sweep = suite.flicker
-    flicker_cases = [c for c in suite.cases if sweep and c.angle in sweep.angles and c.footprint in sweep.footprints]
+    flicker_cases = {c for c in suite.cases if sweep and c.angle in sweep.angles and c.footprint in sweep.footprints}
     valid = [c for c in suite.configs if not void[c]]
     total = (len(suite.cases) * len(suite.configs) + len(suite.tuning) * len(suite.tuning_configs)
              + len(flicker_cases) * (sweep.frames if sweep else 0))
     rows, kept = [], []
     clock = Clock()
+
+    def save(stopped: str = "") -> dict:
+        record = run_record(options, clock.header(report.TITLE, options.command, gpu.summary, suite.name), notes)
+        record["stopped"] = stopped
+        report.TABLE.write(out / "results.csv", rows)
+        write_bytes(out / RUN_FILE, json.dumps(record, indent=1).encode())
+        return record
+
+    done = 0
     with tqdm(total=total, desc="filtering", file=sys.stderr, disable=not progress, leave=False) as bar:
-        for case in suite.cases:
-            case_rows, result = measure_case(make_view(case, suite.size, textures), suite, suite.configs, gpu, void,
-                                             bar.update)
-            for row in case_rows:
-                row["role"] = "rank"
-            rows += case_rows
-            if report.wanted_for_pictures(case, suite):
-                kept.append(result)
-        for case in suite.tuning:
-            case_rows, _ = measure_case(make_view(case, suite.size, textures), suite, suite.tuning_configs, gpu,
-                                        void, bar.update)
-            for row in case_rows:
-                row["role"] = "tune"
-            rows += case_rows
-        for case in flicker_cases:
-            measured = measure_flicker(case, suite, valid, gpu, textures, lambda: bar.update(1))
-            for row in rows:
-                if row["case"] == case.name and row["role"] == "rank" and row["label"] in measured:
-                    row["flicker_psnr"], row["flicker_ratio"], row["flicker_reference_psnr"] = measured[row["label"]]
-    header = clock.header(report.TITLE, options.command, gpu.summary, suite.name)
-    notes = sorted({v for v in void.values() if v})
-    record = run_record(options, header, notes)
-    report.TABLE.write(out / "results.csv", rows)  # the results first: a report can be made again from them
-    write_bytes(out / RUN_FILE, json.dumps(record, indent=1).encode())
+        try:
+            for case in suite.tuning:
+                case_rows, _ = measure_case(make_view(case, suite.size, textures), suite, suite.tuning_configs, gpu,
+                                            void, bar.update)
+                rows += [{**row, "role": "tune"} for row in case_rows]
+                save()
+            for case in suite.cases:
+                case_rows, result = measure_case(make_view(case, suite.size, textures), suite, suite.configs, gpu,
+                                                 void, bar.update)
+                if case in flicker_cases:
+                    measured = measure_flicker(case, suite, valid, gpu, textures, lambda: bar.update(1))
+                    for row in case_rows:
+                        if row["label"] in measured:
+                            row["flicker_psnr"], row["flicker_ratio"], row["flicker_reference_psnr"] = \
+                                measured[row["label"]]
+                rows += [{**row, "role": "rank"} for row in case_rows]
+                if report.wanted_for_pictures(case, suite):
+                    kept.append(result)
+                done += 1
+                save()
+        except KeyboardInterrupt:
+            if done:  # report the finished cases, then stop as asked
+                record = save(f"stopped after {done} of {len(suite.cases)} cases")
+                report.write(out, report.TABLE.read(out / "results.csv"), kept, record)
+            raise
+    record = save()
     rows = report.TABLE.read(out / "results.csv")  # the report quotes the numbers as results.csv holds them
     report.write(out, rows, kept, record)
     return rows
