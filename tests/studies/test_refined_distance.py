@@ -14,7 +14,7 @@ from wgpuviewer.relief.maps import DISTANCE_SLICES, depth_range
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit
 from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
-from wgpuviewer.studies.refined_distance import donnelly, formats, reliefs
+from wgpuviewer.studies.refined_distance import donnelly, formats, pits, reliefs
 from wgpuviewer.studies.refined_distance.baseline import plain_before
 from wgpuviewer.studies.refined_distance.run import CONDITION_PAIRS, PLAIN, SUITES, ratios, run, variants
 from wgpuviewer.studies.refined_distance.tracer import trace
@@ -75,6 +75,13 @@ def test_smoke_suite(tmp_path, gpu):
                                                               for a in suite.format_angles}
     assert all(c["fetches_simd"] >= c["fetches_mean"] > 0 and c["ms"] > 0 for c in res.costs)
     assert "| `distance_refined` | 1056.0 |" in text
+    # the deeper plates: every plate, angle, bins and condition; the table names each plate and angle once
+    assert {(r["plate"], r["angle"], r["bins"], r["visibility"]) for r in res.pits} == {
+        (p.name, a, f"{s} x {n}", vis) for p in pits.PLATES for a in suite.pit_angles for s, n in pits.BINS
+        for vis in ("off", "on")}
+    assert all(r["fetches_mean"] >= 1 for r in res.pits)
+    assert "### Deeper and wider holes" in text and (tmp_path / "pits.csv").exists()
+    assert all(f"| {p.name} |" in text for p in pits.PLATES)
 
 
 def test_cli_rejects_bad_options(tmp_path, capsys):

@@ -27,11 +27,11 @@ def _periodic_count(size: int, pitch: float) -> int:
     return max(1, round(size / pitch))
 
 
-def plate(size: int) -> np.ndarray:
-    """float32 (size, size): 1 on the top, 0 in round holes of PLATE_DIAMETER texels on a hexagonal grid of
-    about PLATE_PITCH texels (the count per side rounded so the map tiles)."""
-    n = _periodic_count(size, PLATE_PITCH)
-    rows = max(2, 2 * round(size / (PLATE_PITCH * np.sqrt(3) / 2) / 2))  # even: the shifted rows tile
+def plate(size: int, diameter: float = PLATE_DIAMETER, pitch: float = PLATE_PITCH) -> np.ndarray:
+    """float32 (size, size): 1 on the top, 0 in round holes of ``diameter`` texels on a hexagonal grid of about
+    ``pitch`` texels (the count per side rounded so the map tiles)."""
+    n = _periodic_count(size, pitch)
+    rows = max(2, 2 * round(size / (pitch * np.sqrt(3) / 2) / 2))  # even: the shifted rows tile
     pitch_x, pitch_y = size / n, size / rows
     y, x = np.mgrid[0:size, 0:size] + 0.5
     row = np.floor(y / pitch_y)
@@ -39,7 +39,7 @@ def plate(size: int) -> np.ndarray:
     cx = (np.floor((x - shift) / pitch_x) + 0.5) * pitch_x + shift
     cy = (row + 0.5) * pitch_y
     r = np.hypot(x - cx, y - cy)
-    return np.where(r <= PLATE_DIAMETER / 2, 0.0, 1.0).astype(np.float32)
+    return np.where(r <= diameter / 2, 0.0, 1.0).astype(np.float32)
 
 
 def grille(size: int) -> np.ndarray:

@@ -27,7 +27,7 @@ from wgpuviewer.relief.accuracy import simd_tile_cost
 from wgpuviewer.relief.maps import DISTANCE_SLICES, depth_range
 from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 
-from . import donnelly, formats, reliefs
+from . import donnelly, formats, pits, reliefs
 from .baseline import plain_before
 from .tracer import trace
 
@@ -123,14 +123,20 @@ class Suite(harness_suite.Suite):
     format_maps: tuple[str, ...]
     format_angles: tuple[float, ...]
     frames: int
+    #: the deeper plates (pits.py): texels per side, angles, random rays per plate and angle, Donnelly's budget
+    pit_size: int
+    pit_angles: tuple[float, ...]
+    pit_rays: int
+    pit_budget: int
 
 
 SUITES = harness_suite.suites(
     Suite("smoke", ("bricks", "plate"), (45.0, 87.0), (32, 16), 32, 256, (60.0,), (8, 64), (32, 64), 30.0,
-          ("plate",), (45.0, 89.0), 2),
+          ("plate",), (45.0, 89.0), 2, 32, (15.0,), 400, 8),
     Suite("full", ("brick", "grass", "gravel", "bricks", "bumps", "ridges", "wall", *reliefs.NAMES),
           (0.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 87.0, 89.0), (256, 144), 256, 4096, (45.0, 60.0, 75.0, 85.0),
-          (8, 16, 32, 64), (256, 512, 1024), 60.0, ("bricks", "plate"), (45.0, 60.0, 75.0, 85.0, 89.0), 5),
+          (8, 16, 32, 64), (256, 512, 1024), 60.0, ("bricks", "plate"), (45.0, 60.0, 75.0, 85.0, 89.0), 5,
+          128, (0.0, 15.0, 30.0, 45.0, 60.0), 20000, 8),
 )
 
 #: results.csv: one row per height map x variant x angle x tracer (the numpy twin; the GPU renderer where a
@@ -197,6 +203,7 @@ class Results:
     donnelly: list[dict]
     formats: list[dict]
     costs: list[dict]
+    pits: list[dict]
 
 
 def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str | None = None,
@@ -214,7 +221,7 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
     if heightmaps is None and not skimage_available():
         maps = tuple(m for m in maps if m not in REAL_MAPS)
     gpu = get_gpu(backend, quiet=True)
-    res = Results([], [], [], [])
+    res = Results([], [], [], [], [])
     out = Path(out)  # checked and made by the command first (harness.study.run_study)
 
     def write():
@@ -223,6 +230,7 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
     chosen = variants()
     format_maps = tuple(m for m in suite.format_maps if heightmaps is None or m in maps) or maps[:1]
     steps = len(maps) * (len(chosen) + 1) + len(formats.FORMATS) + len(format_maps)
+    steps += len(pits.PLATES) if visibility_available() else 0
     with tempfile.TemporaryDirectory(prefix="wgpuviewer-refined-") as workdir, \
             tqdm(total=steps, desc="refined-distance", unit="step", disable=not progress) as bar:
         for name in maps:
@@ -231,6 +239,17 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
             res.donnelly += _donnelly(heightmap, chosen, suite, gpu)
             bar.update()
             write()
+        if visibility_available():
+            def plate_done(rows: list[dict]) -> None:
+                res.pits.extend(rows)
+                bar.update()
+                write()
+
+            def build(height, height_scale, **options):
+                return cached_generate("distance_refined", height, backend="auto", slices=pits.SLICES,
+                                       height_scale=height_scale, **options)
+
+            pits.measure(suite.pit_size, suite.pit_angles, suite.pit_rays, suite.pit_budget, build, plate_done)
         heights = {n: formats_height(format_maps[0], n, Path(workdir)) for n in suite.format_sizes}
 
         def built(b: formats.Built) -> None:
@@ -362,6 +381,8 @@ def _write(out: Path, res: Results, header: Header) -> None:
     DONNELLY_TABLE.write(out / "donnelly.csv", res.donnelly)
     FORMATS_TABLE.write(out / "formats.csv", res.formats)
     COSTS_TABLE.write(out / "format_costs.csv", res.costs)
+    if res.pits:
+        pits.TABLE.write(out / "pits.csv", res.pits)
     plotted = plot(res.rows, out / PLOT)
     write_bytes(out / "report.md", report(res, header, plotted).encode())
 
@@ -451,6 +472,7 @@ def report(res: Results, header: Header, plotted: bool) -> str:
              "mean / SIMD-tile. " + (f"Picture (ratios to the `distance` map): [{PLOT}]({PLOT})." if plotted
                                     else MISSING), ""]
     lines += _condition_section(res.rows)
+    lines += pits.section(res.pits)
     lines += _variant_sections(res.rows)
     lines += _grazing_section(res.rows)
     lines += _donnelly_section(res.donnelly)
