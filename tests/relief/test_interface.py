@@ -28,6 +28,7 @@ ENTRY_RECORDS = {
     "entry/render.wgsl": (shaders.FRAME, shaders.OBJECT, renderer.DATA_OUT),
     "entry/probe.wgsl": (probe.PROBE_RAY, probe.PROBE_HIT),
     "entry/filter_probe.wgsl": (filter_probe.FILTER_SAMPLE, filter_probe.FILTER_OUT),
+    "entry/gradient_probe.wgsl": (filter_probe.GRADIENT_SAMPLE, filter_probe.GRADIENT_VALUE),
     "entry/error_view.wgsl": (error_view.BLIT,),
 }
 
