@@ -248,3 +248,20 @@ def test_the_condition_pairs_compare_a_map_with_itself_but_the_condition(monkeyp
     default = next(o.default for o in kind.options if o.name == study.VISIBILITY)
     (product,) = [v for v in named.values() if v.technique == "distance_refined"]
     assert product.options[study.VISIBILITY] == default and product.bins()["sectors"] == REFINED_SECTORS
+
+
+def test_compact_storages_round_every_value_down():
+    """float16 and 8-bit stored values are never above the float32 ones (a step never grows: safety holds), and
+    lose at most one float16 step / one 8-bit step of the range (values above the 8-bit range are held at it)."""
+    from wgpuviewer.studies.refined_distance.run import EIGHT_BIT_RANGE, STORAGES
+
+    rng = np.random.default_rng(5)
+    v = np.concatenate([rng.random(5000) * 40.0, [0.0, EIGHT_BIT_RANGE, 1e-8, 60000.0]]).astype(np.float32)
+    v64 = v.astype(np.float64)
+    half, _ = STORAGES["float16"]
+    eight, _ = STORAGES["8-bit"]
+    h, e = half(v), eight(v)
+    assert (h <= v64).all() and (e <= v64).all()
+    assert (v64 - h <= np.spacing(v.astype(np.float16)).astype(np.float64) + 1e-12).all()
+    assert (np.minimum(v64, EIGHT_BIT_RANGE) - e <= EIGHT_BIT_RANGE / 255 + 1e-12).all()
+    assert len(np.unique(e)) <= 256

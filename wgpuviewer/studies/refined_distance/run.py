@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from maptools import distance as dist
 from maptools.cache import cached_generate
 from maptools.registry import get_kind
 from wgpuviewer.core.io import write_bytes
@@ -41,6 +42,7 @@ class Variant:
     kind: str  # maptools kind
     options: dict  # beyond slices and height_scale
     technique: str = ""  # the registered technique that renders exactly this map, if any
+    storage: str = ""  # a compact storage of the values (STORAGES), "" as maptools stores them
 
     def bins(self) -> dict:
         """The tracer's view of the map: sectors, bands and max_angle (refined kind) or nothing (plain)."""
@@ -48,6 +50,23 @@ class Variant:
             return {}
         return {k: self.options[k] for k in ("sectors", "bands", "max_angle")}
 
+
+#: Donnelly stored his distances in 8 bits: over [0, EIGHT_BIT_RANGE] texels, larger ones stored as the range.
+EIGHT_BIT_RANGE = 16.0
+
+
+def _float16(v: np.ndarray) -> np.ndarray:
+    return dist.round_down(np.asarray(v, np.float64), np.float16).astype(np.float64)
+
+
+def _eight_bit(v: np.ndarray) -> np.ndarray:
+    v = np.asarray(v, np.float64)
+    return np.minimum(np.floor(np.minimum(v, EIGHT_BIT_RANGE) / EIGHT_BIT_RANGE * 255.0) * EIGHT_BIT_RANGE / 255.0, v)
+
+
+#: Compact storages tried on the plain map: each value rounded DOWN to what the storage holds (a step never grows,
+#: so safety holds), and its bytes per value: float16 (r16float) and Donnelly's 8 bits (r8unorm).
+STORAGES = {"float16": (_float16, 2), "8-bit": (_eight_bit, 1)}
 
 #: The paper's visibility condition as maptools names it (an option of the distance_refined kind).
 VISIBILITY = "visibility"
@@ -72,6 +91,8 @@ VARIANTS = (
     Variant("plain before (maptools-2)", BEFORE, {}),
     Variant("plain K=1", "distance", {"subcells": 1}),
     Variant("plain K=4", "distance", {"subcells": 4}, "distance"),
+    Variant("plain K=4, float16", "distance", {"subcells": 4}, storage="float16"),
+    Variant("plain K=4, 8-bit", "distance", {"subcells": 4}, storage="8-bit"),
     _refined(1, 1),
     _refined(8, 1),
     _refined(1, REFINED_BANDS),
@@ -81,9 +102,10 @@ VARIANTS = (
     _refined(REFINED_SECTORS, REFINED_BANDS, visibility="on"),
 )
 PRODUCT = VARIANTS[-3].name
+SINGLE_CONE = next(v.name for v in VARIANTS if v.kind == "distance_refined")
 PLAIN = "plain K=4"  # the product's `distance` map: the ratios' denominator
 #: The paper's condition: (its map with the condition, the same map without), single cone and binned.
-CONDITION_PAIRS = ((VARIANTS[-2].name, VARIANTS[3].name), (VARIANTS[-1].name, PRODUCT))
+CONDITION_PAIRS = ((VARIANTS[-2].name, SINGLE_CONE), (VARIANTS[-1].name, PRODUCT))
 
 
 def variants() -> tuple[Variant, ...]:
@@ -177,17 +199,23 @@ COSTS_TABLE = Table("refined-distance format costs", (
 TITLE = "Distance-map variants: fetches per pixel (mean / SIMD-tile 8x4)"
 
 #: Donnelly's regime is measured on these variants (those this maptools builds).
-DONNELLY_VARIANTS = (PLAIN, VARIANTS[3].name, VARIANTS[-2].name, PRODUCT, VARIANTS[-1].name)
+DONNELLY_VARIANTS = (PLAIN, SINGLE_CONE, VARIANTS[-2].name, PRODUCT, VARIANTS[-1].name, *(
+    v.name for v in VARIANTS if v.storage))
 
 
-def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[np.ndarray, float]:
+def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[np.ndarray, float, int]:
+    """The variant's volumes (as the tracer reads them), the build's seconds and the bytes they take."""
     t0 = time.perf_counter()
     if variant.kind == BEFORE:
         out = plain_before(height, slices=DISTANCE_SLICES, height_scale=height_scale)
-        return out, time.perf_counter() - t0
+        return out, time.perf_counter() - t0, out.nbytes
     out = cached_generate(variant.kind, height, backend="auto", slices=DISTANCE_SLICES, height_scale=height_scale,
                           **variant.options)
-    return out, time.perf_counter() - t0
+    seconds = time.perf_counter() - t0
+    if variant.storage:
+        store, size = STORAGES[variant.storage]
+        return store(out), seconds, out.size * size
+    return out, seconds, out.nbytes
 
 
 def load(name: str, size: int, workdir: Path):
@@ -283,18 +311,18 @@ def _variants(rows: list[dict], heightmap, chosen, suite: Suite, angles, gpu, ba
     depth_min = depth_range(depth, gpu.depth_format)[0]  # where the GPU tracer starts
     views = [make_view(heightmap, a, suite.resolution) for a in (angles or suite.angles)]
     for variant in chosen:
-        volumes, seconds = _build(variant, heightmap.height, HEIGHT_SCALE)
+        volumes, seconds, nbytes = _build(variant, heightmap.height, HEIGHT_SCALE)
         for view in views:
             covered = np.ones(view.uv0.shape[:2], bool)
             got = trace(depth, volumes, view.uv0.reshape(-1, 2), view.v_ts.reshape(-1, 3), HEIGHT_SCALE,
                         depth_min=depth_min, **variant.bins())
             rows.append(_row(heightmap, view, variant.name, "numpy twin", got.fetches.reshape(covered.shape),
-                             covered, got.capped, seconds, volumes))
+                             covered, got.capped, seconds, nbytes))
             if variant.technique:
                 image = Renderer(view.scene, gpu).render(DrawConfig.of(variant.technique), suite.resolution)
                 fetches, capped = _gpu_fetches(image)
                 rows.append(_row(heightmap, view, variant.name, f"GPU ({gpu.summary})", fetches, image.covered,
-                                 capped, seconds, volumes))
+                                 capped, seconds, nbytes))
         bar.update()
 
 
@@ -305,11 +333,11 @@ def _gpu_fetches(image) -> tuple[np.ndarray, np.ndarray]:
     return np.where(raw < 0, -raw - 1.0, raw), raw[image.covered] < 0
 
 
-def _row(heightmap, view, variant, tracer, fetches, covered, capped, seconds, volumes) -> dict:
+def _row(heightmap, view, variant, tracer, fetches, covered, capped, seconds, nbytes) -> dict:
     return {"heightmap": heightmap.name, "size": f"{heightmap.size[0]}x{heightmap.size[1]}", "angle": view.angle,
             "variant": variant, "tracer": tracer,
             "fetches_mean": float(np.mean(fetches[covered])), "fetches_simd": simd_tile_cost(fetches, covered=covered),
-            "capped": float(np.mean(capped)), "build_s": seconds, "memory_mib": volumes.nbytes / 2**20}
+            "capped": float(np.mean(capped)), "build_s": seconds, "memory_mib": nbytes / 2**20}
 
 
 def _donnelly(heightmap, chosen, suite: Suite, gpu) -> list[dict]:
@@ -327,7 +355,7 @@ def _donnelly(heightmap, chosen, suite: Suite, gpu) -> list[dict]:
         uv, v = random_rays(suite.donnelly_rays, angle, seed=round(angle))
         exact = exact_hit(depth, uv, v, HEIGHT_SCALE)
         for variant in (c for c in chosen if c.name in DONNELLY_VARIANTS):
-            volumes, _ = _build(variant, heightmap.height, HEIGHT_SCALE)
+            volumes, _, _ = _build(variant, heightmap.height, HEIGHT_SCALE)
             for budget in suite.budgets:
                 marched = donnelly.march(volumes, uv, v, HEIGHT_SCALE, budget, **variant.bins())
                 acc = donnelly.accuracy(marched, exact.t, exact.uv, size, v, HEIGHT_SCALE)
@@ -449,7 +477,8 @@ def _draw(plt, rows: list[dict], path: Path) -> None:
 
 #: The report's change columns: (label, variant, against which variant).
 CHANGES = (("K=4 vs before", PLAIN, VARIANTS[0].name), ("product vs before", PRODUCT, VARIANTS[0].name),
-           ("product vs K=4", PRODUCT, PLAIN))
+           ("product vs K=4", PRODUCT, PLAIN),
+           *((f"K=4 {v.storage} vs K=4", v.name, PLAIN) for v in VARIANTS if v.storage))
 
 
 def _pct(a: float | None, b: float | None) -> str:
