@@ -287,7 +287,7 @@ def cell_max_height(depth: np.ndarray) -> np.ndarray:
 
 def maxmip_atlas(levels: list[np.ndarray]) -> np.ndarray:
     """maptools' maxmip levels (ceil-halving) stacked into one (sum of heights, W) float32 image: level m at
-    rows [sum of earlier heights, + h_m), columns [0, w_m). maxmip.wgsl computes the same row offsets."""
+    rows [sum of earlier heights, + h_m), columns [0, w_m). common/maxmip_walk.wgsl computes the same row offsets."""
     width = levels[0].shape[1]
     atlas = np.zeros((sum(level.shape[0] for level in levels), width), np.float32)
     row = 0
