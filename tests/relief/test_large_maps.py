@@ -118,7 +118,7 @@ def test_a_reduced_map_is_said_in_one_line_and_renders(gpu, caplog):
                      "stack 528 layers, more than this adapter's 3D limit of 165 texels); 2x2 sub-cells per cell "
                      "instead of 4x4 (whose bake needs a 144.0 KiB buffer, more than the 36.0 KiB this adapter "
                      "binds); 742.5 KiB; the tracer stays exact, at more fetches per ray; the technique distance "
-                     "(16 slices here, 144.0 KiB) takes about as many fetches or fewer (docs/maps.md)"], lines
+                     "(16 slices here, 72.0 KiB) takes about as many fetches or fewer (docs/maps.md)"], lines
     assert renderer.texture("m", "distance_refined").size == (48, 48, VOLUMES * 5)
     assert image.covered.mean() > 0.2 and np.isfinite(image.data).all()
 

@@ -150,7 +150,7 @@ def test_a_texture_the_adapter_cannot_allocate_is_reported_against_its_scene_key
         renderer.texture("m", "albedo")
     renderer = Renderer(s, other_gpu(gpu, fail="m.distance", error=error))  # a 3D map: against the height key
     with pytest.raises(UserError, match=r"^<scene>: materials.m.height = \{'builtin': 'bumps', 'size': \[8, 8\]\}: "
-                                        r"its distance map cannot be built: m.distance needs 4.0 KiB of GPU memory"):
+                                        r"its distance map cannot be built: m.distance needs 2.0 KiB of GPU memory"):
         renderer.texture("m", "distance")
 
 

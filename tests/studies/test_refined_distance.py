@@ -10,7 +10,7 @@ import pytest
 from maptools.cache import cached_generate
 from wgpuviewer.bench.run import REAL_MAPS
 from wgpuviewer.relief.accuracy import random_rays
-from wgpuviewer.relief.maps import DISTANCE_SLICES, depth_range
+from wgpuviewer.relief.maps import DISTANCE_SLICES, depth_range, uploaded_volume
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit
 from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
@@ -25,7 +25,7 @@ from wgpuviewer.textures import BUILTINS, builtin_height
 def test_twin_takes_the_gpu_tracers_steps(gpu, name):
     h = builtin_height(name, (48, 48)).astype(np.float64)
     depth = 1.0 - h
-    plain = cached_generate("distance", h, backend="auto", slices=DISTANCE_SLICES, height_scale=0.05)
+    plain = uploaded_volume(cached_generate("distance", h, backend="auto", slices=DISTANCE_SLICES, height_scale=0.05))
     refined = cached_generate("distance_refined", h, backend="auto", slices=DISTANCE_SLICES, height_scale=0.05,
                               sectors=REFINED_SECTORS, bands=REFINED_BANDS, max_angle=REFINED_MAX_ANGLE)
     bins = {"sectors": REFINED_SECTORS, "bands": REFINED_BANDS, "max_angle": REFINED_MAX_ANGLE}
@@ -217,7 +217,7 @@ def test_format_bytes_and_extrapolated_builds(gpu):
     heights = {8: reliefs.plate(8), 16: reliefs.plate(16)}
     built = formats.measure(heights, gpu, budget_s=0.0, formats=("distance", "distance_refined", "cone"))
     by = {(b.format, b.backend, b.size): b for b in built}
-    assert by["distance", "gpu", 8].bytes_per_texel == DISTANCE_SLICES * 4  # r32float
+    assert by["distance", "gpu", 8].bytes_per_texel == DISTANCE_SLICES * 2  # r16float (uploaded_volume)
     assert by["distance_refined", "gpu", 8].bytes_per_texel == (REFINED_SECTORS * REFINED_BANDS + 1) * \
         DISTANCE_SLICES * 2  # r16float, every bin and the plain volume
     assert by["cone", "cpu", 8].bytes_per_texel == 8  # rg32float

@@ -162,8 +162,8 @@ class VolumePlan:
 
     @property
     def nbytes(self) -> int:
-        """Bytes of the texture: float16 refined volumes, a float32 plain one."""
-        return self.width * self.height * self.slices * self.volumes * (2 if self.kind == "distance_refined" else 4)
+        """Bytes of the texture: float16 volumes (``uploaded_volume``)."""
+        return self.width * self.height * self.slices * self.volumes * 2
 
     def note(self, label: str) -> str:
         """The one line saying what was chosen and why (for a reduced plan)."""
@@ -410,11 +410,20 @@ def _planned(gpu: Gpu, kind: str, depth: np.ndarray, label: str) -> VolumePlan:
     return plan
 
 
+def uploaded_volume(volume: np.ndarray) -> np.ndarray:
+    """A distance volume as the renderer uploads it: float16, every value rounded down (a step never grows, so
+    the map stays safe). For the plain map this halves its memory; the refined-distance study measures the cost
+    within +-0.2 % of the fetches (docs/maps.md). The refined kind is float16 already."""
+    if volume.dtype == np.float16:
+        return volume
+    return distance_kind.round_down(np.asarray(volume, np.float64), np.float16)
+
+
 def _distance(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
     plan = _planned(gpu, "distance", depth, label)
     volume = cached_generate("distance", 1.0 - depth, backend="auto", slices=plan.slices, subcells=plan.subcells,
                              height_scale=height_scale)
-    return _volume_texture(gpu, volume, label)
+    return _volume_texture(gpu, uploaded_volume(volume), label)
 
 
 def _distance_refined(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
@@ -465,7 +474,8 @@ MAP_SLOTS: dict[str, MapSlot] = {
         MapSlot("maxmip", _2D, _UNFILTERABLE_2D, _maxmip,
                 "max pyramid atlas (r32float): level m at rows [row_m, row_m + h_m), textureLoad", check=_check_maxmip),
         # distance.wgsl reads whichever of the two distance volumes its technique needs, as distance_tex.
-        MapSlot("distance", _3D, _VOLUME, _distance, "distance volume (W, H, slices), r32float, textureLoad",
+        MapSlot("distance", _3D, _VOLUME, _distance, "distance volume (W, H, slices), r16float rounded down, "
+                "textureLoad",
                 check=_check_distance, scale_bound=True),
         MapSlot("distance_refined", _3D, _VOLUME, _distance_refined,
                 "direction-binned refined volumes and the plain one, stacked along the depth (r16float), textureLoad",

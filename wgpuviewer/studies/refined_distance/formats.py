@@ -14,7 +14,7 @@ import numpy as np
 
 import maptools
 from wgpuviewer.bench.view import HEIGHT_SCALE
-from wgpuviewer.relief.maps import cell_max_height, footprint_min_depth, maxmip_atlas, quadmax_atlas, volume_plan
+from wgpuviewer.relief.maps import cell_max_height, footprint_min_depth, maxmip_atlas, quadmax_atlas, uploaded_volume, volume_plan
 from wgpuviewer.relief.techniques import CONE_FILTER, CONE_MAX_RATIO, REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 
 FORMATS = ("distance", "distance_refined", "cone", "maxmip", "quadmax")
@@ -40,8 +40,8 @@ def build(fmt: str, height: np.ndarray, backend: str, gpu) -> tuple[float, str]:
         plan = volume_plan(gpu, fmt, w, h)
         extra = ({"max_angle": REFINED_MAX_ANGLE, "sectors": REFINED_SECTORS, "bands": REFINED_BANDS}
                  if fmt == "distance_refined" else {})
-        volume = maptools.generate(fmt, height, backend=backend, slices=plan.slices, subcells=plan.subcells,
-                                   height_scale=HEIGHT_SCALE, **extra)
+        volume = uploaded_volume(maptools.generate(fmt, height, backend=backend, slices=plan.slices,
+                                                   subcells=plan.subcells, height_scale=HEIGHT_SCALE, **extra))
         bins = f", {REFINED_SECTORS}x{REFINED_BANDS} bins + plain" if extra else ""
         return volume.nbytes / (w * h), f"{plan.slices} slices, {plan.subcells}² sub-cells{bins}, {volume.dtype}"
     if fmt == "cone":

@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 
-from maptools import distance as dist
 from maptools.cache import cached_generate
 from maptools.registry import get_kind
 from wgpuviewer.core.io import write_bytes
@@ -25,7 +24,7 @@ from wgpuviewer.harness.header import Clock, Header
 from wgpuviewer.harness.plots import MISSING, pyplot, save_png
 from wgpuviewer.harness.table import Column, Table
 from wgpuviewer.relief.accuracy import simd_tile_cost
-from wgpuviewer.relief.maps import DISTANCE_SLICES, depth_range
+from wgpuviewer.relief.maps import DISTANCE_SLICES, depth_range, uploaded_volume
 from wgpuviewer.relief.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 
 from . import donnelly, formats, pits, reliefs
@@ -55,18 +54,15 @@ class Variant:
 EIGHT_BIT_RANGE = 16.0
 
 
-def _float16(v: np.ndarray) -> np.ndarray:
-    return dist.round_down(np.asarray(v, np.float64), np.float16).astype(np.float64)
-
-
 def _eight_bit(v: np.ndarray) -> np.ndarray:
     v = np.asarray(v, np.float64)
     return np.minimum(np.floor(np.minimum(v, EIGHT_BIT_RANGE) / EIGHT_BIT_RANGE * 255.0) * EIGHT_BIT_RANGE / 255.0, v)
 
 
-#: Compact storages tried on the plain map: each value rounded DOWN to what the storage holds (a step never grows,
-#: so safety holds), and its bytes per value: float16 (r16float) and Donnelly's 8 bits (r8unorm).
-STORAGES = {"float16": (_float16, 2), "8-bit": (_eight_bit, 1)}
+#: Storages of the plain map: each value rounded DOWN to what the storage holds (a step never grows, so safety
+#: holds), and its bytes per value: float16 (r16float, what the renderer uploads: relief.maps.uploaded_volume) and
+#: Donnelly's 8 bits (r8unorm); maptools' own float32 is the variant without a storage.
+STORAGES = {"float16": (lambda v: uploaded_volume(v).astype(np.float64), 2), "8-bit": (_eight_bit, 1)}
 
 #: The paper's visibility condition as maptools names it (an option of the distance_refined kind).
 VISIBILITY = "visibility"
@@ -90,8 +86,8 @@ def _refined(sectors: int, bands: int, technique: str = "", visibility: str = ""
 VARIANTS = (
     Variant("plain before (maptools-2)", BEFORE, {}),
     Variant("plain K=1", "distance", {"subcells": 1}),
-    Variant("plain K=4", "distance", {"subcells": 4}, "distance"),
-    Variant("plain K=4, float16", "distance", {"subcells": 4}, storage="float16"),
+    Variant("plain K=4", "distance", {"subcells": 4}, "distance", storage="float16"),
+    Variant("plain K=4, float32", "distance", {"subcells": 4}),
     Variant("plain K=4, 8-bit", "distance", {"subcells": 4}, storage="8-bit"),
     _refined(1, 1),
     _refined(8, 1),
@@ -199,8 +195,9 @@ COSTS_TABLE = Table("refined-distance format costs", (
 TITLE = "Distance-map variants: fetches per pixel (mean / SIMD-tile 8x4)"
 
 #: Donnelly's regime is measured on these variants (those this maptools builds).
-DONNELLY_VARIANTS = (PLAIN, SINGLE_CONE, VARIANTS[-2].name, PRODUCT, VARIANTS[-1].name, *(
-    v.name for v in VARIANTS if v.storage))
+#: The plain map in maptools' float32 and in Donnelly's 8 bits (the product's is float16: PLAIN).
+OTHER_STORAGES = ("plain K=4, float32", "plain K=4, 8-bit")
+DONNELLY_VARIANTS = (PLAIN, SINGLE_CONE, VARIANTS[-2].name, PRODUCT, VARIANTS[-1].name, *OTHER_STORAGES)
 
 
 def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[np.ndarray, float, int]:
@@ -478,7 +475,7 @@ def _draw(plt, rows: list[dict], path: Path) -> None:
 #: The report's change columns: (label, variant, against which variant).
 CHANGES = (("K=4 vs before", PLAIN, VARIANTS[0].name), ("product vs before", PRODUCT, VARIANTS[0].name),
            ("product vs K=4", PRODUCT, PLAIN),
-           *((f"K=4 {v.storage} vs K=4", v.name, PLAIN) for v in VARIANTS if v.storage))
+           *((f"K=4 {name.split(', ')[1]} vs float16", name, PLAIN) for name in OTHER_STORAGES))
 
 
 def _pct(a: float | None, b: float | None) -> str:
