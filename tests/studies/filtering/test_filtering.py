@@ -15,10 +15,27 @@ from wgpuviewer.relief.filters import DERIVATIVE_LIMIT, FILTERS, FLAGS
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.studies.filtering import supersample as ss
-from wgpuviewer.studies.filtering.report import place_labels
+from wgpuviewer.studies.filtering.report import DOCS_BEGIN, DOCS_END, docs_block_of, place_labels, rereport
 from wgpuviewer.studies.filtering.run import flicker_psnr, flicker_ratio, psnr, psnr_uncertainty, unresolved, void_reason
-from wgpuviewer.studies.filtering.suites import EXPLICIT_GRADIENTS, TABLE, TUNING_CONFIGS, Config, inherit_available
-from wgpuviewer.studies.filtering.views import HEIGHT_SCALE, MASK_LEVEL, TEXTURE_SIZE, Case, albedo_image, depth_map, make_view
+from wgpuviewer.studies.filtering.suites import (
+    EXPLICIT_GRADIENTS,
+    SUITES,
+    TABLE,
+    TUNING_CONFIGS,
+    Config,
+    inherit_available,
+    resolve_options,
+)
+from wgpuviewer.studies.filtering.views import (
+    ALBEDOS,
+    HEIGHT_SCALE,
+    MASK_LEVEL,
+    TEXTURE_SIZE,
+    Case,
+    albedo_image,
+    depth_map,
+    make_view,
+)
 from wgpuviewer.textures import builtin_height
 
 SIZE = (32, 24)
@@ -257,6 +274,35 @@ def test_render_with_a_filter(tmp_path, adapter):
     assert a.shape == b.shape == (36, 64, 3) and 0.1 < np.abs(a - b).mean() < 30
 
 
+def test_a_stopped_run_keeps_and_reports_the_cases_it_finished(tmp_path, gpu, monkeypatch):
+    """Ctrl-C or gpu-suite's SIGTERM during the third case: results.csv holds the first two, report.md says so."""
+    from wgpuviewer.studies.filtering import run as run_module
+
+    options = resolve_options("smoke", size=(16, 12), frames=1, filters=["trilinear"])
+    calls = []
+    measure = run_module.measure_case
+
+    def stopping(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return measure(*args, **kwargs)
+
+    monkeypatch.setattr(run_module, "measure_case", stopping)
+    with pytest.raises(KeyboardInterrupt):
+        run_module.run(options, tmp_path, progress=False)
+    rows = TABLE.read(tmp_path / "results.csv")
+    assert [r["case"] for r in rows if r["label"] == "trilinear (uv)"] == [c.name for c in options.suite.cases[:2]]
+    assert "**stopped after 2 of 3 cases**" in (tmp_path / "report.md").read_text()
+
+
+def test_full_suite_measures_the_grazing_middle_footprint_first():
+    cases = SUITES["full"].cases
+    first = [c for c in cases[:len({(c.relief, c.albedo) for c in cases})]]
+    assert {(c.angle, c.footprint) for c in first} == {(80.0, 2.0)}
+    assert len(cases) == len(set(cases)) == 3 * 5 * 5 * 3 + 4 * 5 * 3
+
+
 def test_smoke_suite_end_to_end(tmp_path, gpu):
     out = tmp_path / "smoke"
     assert main(["filtering", "--out", str(out), "--suite", "smoke", "--quiet"]) == 0
@@ -308,3 +354,31 @@ def test_smoke_suite_end_to_end(tmp_path, gpu):
         (again / crop.name).write_bytes(crop.read_bytes())
     assert main(["filtering", "--out", str(again), "--from-csv", str(out / "results.csv"), "--quiet"]) == 0
     assert (again / "report.md").read_text() == report
+
+
+# --- the committed run: docs and report quote its results.csv -------------------------------------------------
+
+COMMITTED = Path(__file__).resolve().parents[3] / "benchmarks" / "filtering_lavapipe"
+DOCS = Path(__file__).resolve().parents[3] / "docs" / "filtering.md"
+
+
+def test_docs_quote_the_committed_run():
+    """docs/filtering.md's generated block is the one its committed results.csv gives, to the character."""
+    text = DOCS.read_text()
+    start, end = text.index(DOCS_BEGIN), text.index(DOCS_END) + len(DOCS_END)
+    assert text[start:end] == docs_block_of(COMMITTED)
+
+
+def test_committed_report_is_its_results_csv(tmp_path):
+    """The committed report.md is what its results.csv and run.json give (nothing edited by hand)."""
+    for crop in COMMITTED.glob("crops_*.png"):
+        (tmp_path / crop.name).write_bytes(crop.read_bytes())
+    rereport(COMMITTED / "results.csv", tmp_path)
+    ours = (tmp_path / "report.md").read_text()
+    assert ours == (COMMITTED / "report.md").read_text()
+    rows = TABLE.read(COMMITTED / "results.csv")
+    assert {r["footprint"] for r in rows if r["role"] == "rank"} == {1.0, 2.0, 4.0}
+    assert {r["albedo"] for r in rows if r["role"] == "rank"} == set(ALBEDOS)
+    assert {r["tracer"] for r in rows} == {"maxmip", "pom32"}
+    assert any(r["void"] for r in rows) and any("inherit=1" in r["label"] for r in rows)
+    assert any(np.isfinite(r["flicker_psnr"]) for r in rows) and any(r["role"] == "tune" for r in rows)

@@ -167,51 +167,76 @@ def recommendation(rows: list[dict]) -> list[str]:
     """Per group and tracer: the most accurate configuration, what it gains over trilinear and bilinear (mean and
     the per-case range), its cost, its flicker, and the cheapest configuration within NEAR_BEST_DB of it."""
     valid = ranked(rows)
-    lines = ["| cases | tracer | most accurate (PSNR box / Gaussian ref) | vs trilinear, dB: mean [per-case min, max] "
-             "| vs bilinear, dB: mean [min, max] | time x trilinear | flicker dB (trilinear's) | cheapest within "
-             f"{NEAR_BEST_DB} dB: time x trilinear | cases |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| cases | tracer | most accurate: PSNR box / Gaussian ref | vs trilinear, dB: mean [per-case min, max] "
+             "| vs bilinear, dB: mean [min, max] | time x trilinear | flicker dB | cheapest within "
+             f"{NEAR_BEST_DB} dB: PSNR, time x trilinear, flicker dB | trilinear's flicker dB | cases |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for title, subset in groups_of(valid).items():
         for tracer in TRACER_NAMES:
             mine = [r for r in subset if r["tracer"] == tracer]
             if not mine:
                 continue
-            stats = {name: (_mean([r["psnr"] for r in g]), _geomean([r["time_ratio"] for r in g]))
-                     for name, g in by_config(mine).items()}
+            groups = by_config(mine)
+            stats = {name: (_mean([r["psnr"] for r in g]), _geomean([r["time_ratio"] for r in g]),
+                            _mean([r["flicker_psnr"] for r in g])) for name, g in groups.items()}
             best = max(stats, key=lambda k: stats[k][0] if math.isfinite(stats[k][0]) else -1e9)
-            group = by_config(mine)[best]
-            near = [k for k, (p, t) in stats.items() if p >= stats[best][0] - NEAR_BEST_DB and math.isfinite(t)]
+            near = [k for k, (p, t, _) in stats.items() if p >= stats[best][0] - NEAR_BEST_DB and math.isfinite(t)]
             cheap = min(near, key=lambda k: stats[k][1]) if near else best
             tri, bil = BASELINE.on(tracer).label, BILINEAR.on(tracer).label
             cells = []
             for base in (tri, bil):
                 d = differences(mine, best, base)
                 cells.append(f"{_fmt(_mean(d))} [{_fmt(min(d) if d else math.nan)}, {_fmt(max(d) if d else math.nan)}]")
-            flick = _mean([r["flicker_psnr"] for r in group])
-            flick_base = _mean([r["flicker_psnr"] for r in by_config(mine).get(tri, [])])
             lines.append(
                 f"| {title} | {TRACER_NAMES[tracer]} | `{best}` {_fmt(stats[best][0], '.2f')} / "
-                f"{_fmt(_mean([r['psnr_gauss'] for r in group]), '.2f')} | {cells[0]} | {cells[1]} | "
-                f"{_fmt(stats[best][1], '.2f')} | {_fmt(flick, '.1f')} ({_fmt(flick_base, '.1f')}) | "
-                f"`{cheap}` {_fmt(stats[cheap][0], '.2f')} dB: {_fmt(stats[cheap][1], '.2f')} | "
-                f"{len({r['case'] for r in mine})} |")
+                f"{_fmt(_mean([r['psnr_gauss'] for r in groups[best]]), '.2f')} | {cells[0]} | {cells[1]} | "
+                f"{_fmt(stats[best][1], '.2f')} | {_fmt(stats[best][2], '.1f')} | `{cheap}` "
+                f"{_fmt(stats[cheap][0], '.2f')}, {_fmt(stats[cheap][1], '.2f')}, {_fmt(stats[cheap][2], '.1f')} | "
+                f"{_fmt(stats.get(tri, (0, 0, math.nan))[2], '.1f')} | {len({r['case'] for r in mine})} |")
     return lines
 
 
 def derivative_sources(rows: list[dict]) -> list[str]:
     """Plain EWA per derivative source and group (exact tracer): mean PSNR and the gain over trilinear."""
     valid = [r for r in ranked(rows) if r["tracer"] == EXACT]
-    lines = ["| cases | " + " | ".join(f"ewa ({s}): PSNR, vs trilinear" for s in ("uv", "displaced", "analytic"))
-             + " |", "|---|---|---|---|"]
+    lines = ["| cases | " + " | ".join(f"ewa ({s}): PSNR, vs trilinear, time x trilinear"
+                                      for s in ("uv", "displaced", "analytic")) + " |", "|---|---|---|---|"]
     for title, subset in groups_of(valid).items():
         if not subset:
             continue
         cells = []
         for source in ("uv", "displaced", "analytic"):
             name = label("ewa", source)
-            cells.append(f"{_fmt(_mean([r['psnr'] for r in subset if r['label'] == name]), '.2f')}, "
-                         f"{_fmt(_mean(differences(subset, name, BASELINE.label)))}")
+            mine = [r for r in subset if r["label"] == name]
+            cells.append(f"{_fmt(_mean([r['psnr'] for r in mine]), '.2f')}, "
+                         f"{_fmt(_mean(differences(subset, name, BASELINE.label)))}, "
+                         f"{_fmt(_geomean([r['time_ratio'] for r in mine]), '.2f')}")
         lines.append(f"| {title} | {' | '.join(cells)} |")
+    return lines
+
+
+def measures(rows: list[dict], start_rays: int) -> list[str]:
+    """The reference's own error per albedo and how often it was raised from ``start_rays``; the traced derivative
+    sources' raw length ratios and how often they were bounded (exact tracer, ranked cases)."""
+    rank = [r for r in rows if r["role"] == "rank" and r["tracer"] == EXACT]
+    one = [r for r in rank if r["label"] == BASELINE.label]  # one row per case
+    if not one:
+        return []
+    ranges = "; ".join(f"{a} {min(v):.1f}–{max(v):.1f}" for a in ALBEDOS
+                       if (v := [r["reference_psnr_half"] for r in one if r["albedo"] == a]))
+    raised = sum(r["reference_rays"] > start_rays for r in one)
+    lines = [f"- Reference, half against full rays (PSNR dB, per albedo): {ranges}; raised from {start_rays} to "
+             f"{max(r['reference_rays'] for r in one)} rays per side in {raised} of {len(one)} cases; every compared "
+             f"difference resolved in {sum(bool(r['reference_resolved']) for r in one)}."]
+    for source in ("displaced", "analytic"):
+        g = [r for r in rank if r["label"] == label("ewa", source) and r["occluding"]]
+        if g:
+            top = max(r["ratio_max"] for r in g)
+            p99 = max(r["ratio_p99"] for r in g)
+            lines.append(f"- `{source}` derivatives on occluding relief: raw length up to {top:.0f}x the unperturbed "
+                         f"one (a case's 99th percentile up to {p99:.1f}x); "
+                         f"bounded in {_mean([r['bounded_share'] for r in g]):.1%} of the pixels on average, at most "
+                         f"{max(r['bounded_share'] for r in g):.1%}.")
     return lines
 
 
@@ -563,6 +588,9 @@ def markdown(rows: list[dict], record: dict, pictures: list[str], pareto: str | 
               "trilinear | bilinear | ewa_vis - ewa (displaced / analytic) | inherit - drop (displaced) | "
               "ewa capped | displaced ratio p99 / max |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    intro = measures(rows, record.get("reference", 16))
+    if intro:
+        lines[-3:-3] = [*intro, ""]
     per_case = defaultdict(list)
     for r in ranked(rows):
         if r["tracer"] == EXACT:
@@ -601,7 +629,8 @@ def docs_block(rows: list[dict], record: dict) -> str:
     void_labels = sorted({r["label"] for r in rows if r["void"]})
     lines = [DOCS_BEGIN, "", *recommendation(rows), "", "Plain EWA by derivative source (exact tracer):", "",
              *derivative_sources(rows), "", "Visibility against plain EWA on the same footprint:", "",
-             *visibility(rows), "", *weighting(rows), "", *flicker(rows), "", *tuning(rows), ""]
+             *visibility(rows), "", *weighting(rows), "", *flicker(rows), "", *tuning(rows), "",
+             *measures(rows, record.get("reference", 16)), ""]
     if void_labels:
         lines += [f"Void on this adapter (in results.csv, in no aggregate): {', '.join(f'`{v}`' for v in void_labels)}"
                   f". {' '.join(record.get('void_notes', []))}", ""]
