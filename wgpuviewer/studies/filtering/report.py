@@ -23,7 +23,7 @@ from wgpuviewer.core.io import write_bytes
 from wgpuviewer.harness.header import Header
 from wgpuviewer.harness.plots import pyplot, save_png
 
-from .suites import BASELINE, BILINEAR, EXACT, TABLE, Config, Suite
+from .suites import BASELINE, BILINEAR, EXACT, RUN_FILE, TABLE, Config, Suite
 from .views import ALBEDOS, HEIGHT_SCALE, RELIEFS, TECHNIQUE, Case
 
 __all__ = ["TABLE", "TITLE", "rereport", "write", "wanted_for_pictures", "recommendation"]
@@ -77,8 +77,6 @@ def write_report(out: Path, rows: list[dict], record: dict) -> None:
 def rereport(csv: Path, out: Path) -> None:
     """report.md and the plots again from ``csv`` (and the run.json beside it) into ``out``; the crops are those
     already in ``out``."""
-    from .run import RUN_FILE
-
     rows = TABLE.read(csv)
     if not rows:
         raise UserError(f"--from-csv {csv}: no rows; give the results.csv of a filtering run")
@@ -640,7 +638,5 @@ def docs_block(rows: list[dict], record: dict) -> str:
 
 def docs_block_of(folder: Path) -> str:
     """``docs_block`` of the run in ``folder`` (its results.csv and run.json)."""
-    from .run import RUN_FILE
-
     return docs_block(TABLE.read(Path(folder) / "results.csv"),
                       json.loads((Path(folder) / RUN_FILE).read_text()))

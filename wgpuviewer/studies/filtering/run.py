@@ -33,7 +33,7 @@ from wgpuviewer.harness.header import Clock
 from wgpuviewer.relief.filters import FLAGS
 from wgpuviewer.relief.renderer import Renderer
 
-from .suites import BASELINE, EXACT, EXPLICIT_GRADIENTS, Config, Options, Suite
+from .suites import BASELINE, EXACT, EXPLICIT_GRADIENTS, RUN_FILE, Config, Options, Suite
 from .supersample import Supersample, supersample
 from .views import Case, View, make_view
 
@@ -47,7 +47,6 @@ COMPARED = (
     ("ewa (analytic)", "trilinear (uv)"), ("ewa (analytic)", "bilinear (uv)"),
 )
 EQUAL_DB = 0.1  # differences below this are reported as equal, resolved or not
-RUN_FILE = "run.json"  # what report.md's header needs when it is made again from results.csv
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:

@@ -173,6 +173,8 @@ SUITES = harness_suite.suites(
           _full_configs(), frames=10, tuning=TUNING_CASES),
 )
 
+RUN_FILE = "run.json"  # beside results.csv: what report.md's header needs when it is made again from the results
+
 #: results.csv: one row per case x configuration.
 TABLE = Table("filtering results", (
     Column("case", str), Column("role", str, "rank: ranks the filters; tune: tunes EWA's alpha"),
