@@ -84,7 +84,7 @@ def test_generated_filter_interface_follows_the_registry():
     ewa = filters.filter_params(FILTERS["ewa"])
     assert ewa.fields[:2] == (("max_texels", "u32"), ("alpha", "f32"))
     record = ewa.unpack(filters.pack_filter_params(FILTERS["ewa"], {"max_texels": 64}))[0]
-    assert (record["max_texels"], record["alpha"]) == (64, 6.0)
+    assert (record["max_texels"], record["alpha"]) == (64, 4.0)
 
 
 def test_unknown_names_are_user_errors():

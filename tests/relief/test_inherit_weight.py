@@ -134,8 +134,9 @@ def test_substitutes_inside_the_ellipse_are_not_counted_again(gpu):
     dx = np.repeat(np.array([[9.0, 0.0]]) / 64, len(uv), axis=0)
     dy = dx[:, ::-1]
     texture = textures()["noise 64x48"]
-    got, want = gpu_and_cpu("ewa_vis", texture, uv, dx, dy, view, height, params=INHERIT)
-    drop = filter_probe("ewa_vis", texture, uv, dx, dy, view, height=height)
+    sharp = {"alpha": 6.0}  # the ellipse this case is laid out for (alpha sets its prefilter's size)
+    got, want = gpu_and_cpu("ewa_vis", texture, uv, dx, dy, view, height, params={**INHERIT, **sharp})
+    drop = filter_probe("ewa_vis", texture, uv, dx, dy, view, height=height, filter_params=sharp)
     assert (got.hidden > 0).all()
     assert all(not any(w.substitutes.values()) for w in want)  # every substitute fell inside
     for field in ("value", "texels", "hidden", "flags"):
