@@ -6,7 +6,9 @@ directions w (unit, metric, Z down) of the view cone (polar angle <= max_angle f
 bins: ``sectors`` equal sectors of the azimuth of w's horizontal part x ``bands`` polar bands of equal cosine ratio
 (edge k at cos = cos(max_angle)^(k / bands): over a flat floor a bin's value is then the same fraction of its
 rays' free path in every band). One volume per bin, plus the plain map as the last volume for rays steeper than
-max_angle. With sectors = 1 and bands = 1 the single bin is the whole cone: the refined map as the paper defines it.
+max_angle. With sectors = 1 and bands = 1 the single bin is the whole cone, and with ``visibility="on"`` as well
+that is the refined map as the paper defines it (one value per voxel for the whole cone, only the directions that can
+reach the voxel counted).
 
 Value of voxel box B for bin Omega: a lower bound of the free path of every ray that starts in B with a direction
 in Omega, i.e. of min |q - p| over p in B, q in the outer solid O, q - p in the cone K(Omega). For one sub-cell
