@@ -22,6 +22,7 @@ from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import write_bytes
 from wgpuviewer.harness.header import Header
 from wgpuviewer.harness.plots import pyplot, save_png
+from wgpuviewer.relief.filters import get_filter
 
 from .suites import BASELINE, BILINEAR, EXACT, RUN_FILE, TABLE, Config, Suite
 from .views import ALBEDOS, HEIGHT_SCALE, RELIEFS, TECHNIQUE, Case
@@ -305,9 +306,12 @@ def tuning(rows: list[dict]) -> list[str]:
     if ewa:
         box_best = max(ewa, key=lambda s: s[1])[0]
         gauss_best = max(ewa, key=lambda s: s[2])[0]
+        default = get_filter("ewa").defaults()["alpha"]
+        follows = (f"the default alpha ({default:g}) is this best" if box_best == f"ewa alpha={default:g} (analytic)"
+                   else f"the default alpha ({default:g}) is not this best: set it from these cases and rank again")
         lines += ["", f"Best on the tuning cases ({', '.join(sorted({r['case'] for r in tune}))}): `{box_best}` "
                       f"against the box reference, `{gauss_best}` against the Gaussian one. The ranked cases use "
-                      "the default alpha (6) and Heckbert's 2, fixed before any ranked case was measured."]
+                      f"the default alpha and Heckbert's 2; {follows}."]
     return lines
 
 
