@@ -85,12 +85,18 @@ def subcell_tops(depth: np.ndarray, k: int) -> np.ndarray:
     return out
 
 
-def cell_tops(depth: np.ndarray) -> np.ndarray:
-    """Top of each whole bilinear cell [i + 0.5, i + 1.5] x [j + 0.5, j + 1.5] (texels): the least of its four corner
-    depths, float64 (H, W) at [j, i]. Equals the minimum over the cell's sub-cell tops for every K."""
+def cell_corners(depth: np.ndarray, reduce=np.minimum) -> np.ndarray:
+    """``reduce`` (np.minimum / np.maximum) of each bilinear cell's four corner depths, float64 (H, W) at [j, i]:
+    the cell [i + 0.5, i + 1.5] x [j + 0.5, j + 1.5] (texels), wrapping."""
     d = np.asarray(depth, np.float64)
     right = np.roll(d, -1, axis=1)
-    return np.minimum(np.minimum(d, right), np.minimum(np.roll(d, -1, axis=0), np.roll(right, -1, axis=0)))
+    return reduce(reduce(d, right), reduce(np.roll(d, -1, axis=0), np.roll(right, -1, axis=0)))
+
+
+def cell_tops(depth: np.ndarray) -> np.ndarray:
+    """Top of each whole bilinear cell (the outer solid's column): the least of its four corner depths. Equals the
+    minimum over the cell's sub-cell tops for every K."""
+    return cell_corners(depth, np.minimum)
 
 
 def interval_gap(lo, hi, half):

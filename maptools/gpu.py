@@ -323,10 +323,10 @@ def distance_refined(g: MapGpu, height: np.ndarray, *, slices: int = 16, height_
         rings, ring_ends = [], []
         for b in rf.bins(sectors, 1, max_angle):
             ring = rf.horizon_rings(b, w / h, reach)
-            offsets = np.zeros((max(1, sum(len(ox) for ox, _ in ring)), 2), np.uint32)
-            offsets[:sum(len(ox) for ox, _ in ring)] = np.concatenate(
-                [np.stack([np.mod(ox, w), np.mod(oy, h)], axis=1) for ox, oy in ring])
-            rings.append(g.storage(offsets, "maptools distance_refined rings"))
+            offsets = np.concatenate([np.stack([np.mod(ox, w), np.mod(oy, h)], axis=1) for ox, oy in ring])
+            # a storage buffer is never empty: one unread entry where no ring holds a cell
+            rings.append(g.storage(offsets.astype(np.uint32) if len(offsets) else np.zeros((1, 2), np.uint32),
+                                   "maptools distance_refined rings"))
             ends = np.cumsum([len(ox) for ox, _ in ring]).astype(np.uint32)
             ring_ends.append(g.storage(ends, "maptools distance_refined ring ends"))
     out = np.empty((len(directions) + 1, slices, h, w), np.float16)

@@ -276,9 +276,7 @@ def entries(b: Bin, k: int, sy: float, reach: float) -> Entries:
 def inner_tops(depth: np.ndarray) -> np.ndarray:
     """Top of the inner solid's column over each bilinear cell [i + 0.5, i + 1.5] x [j + 0.5, j + 1.5] (texels): the
     DEEPEST of its four corner depths (the bilinear patch is nowhere deeper), float64 (H, W) at [j, i]."""
-    d = np.asarray(depth, np.float64)
-    right = np.roll(d, -1, axis=1)
-    return np.maximum(np.maximum(d, right), np.maximum(np.roll(d, -1, axis=0), np.roll(right, -1, axis=0)))
+    return dist.cell_corners(depth, np.maximum)
 
 
 def ring_count(reach: float) -> int:
