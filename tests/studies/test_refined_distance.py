@@ -228,19 +228,13 @@ def test_format_bytes_and_extrapolated_builds(gpu):
             assert b.bytes_per_texel == by[fmt, "gpu", 8].bytes_per_texel
 
 
-def test_the_condition_pairs_compare_a_map_with_itself_but_the_condition(monkeypatch):
-    """With the visibility option (as maptools' refined kind has it or will): each pair differs only in the
-    condition, "off" set explicitly; the renderer's technique sits on the product's bins with the kind's default."""
-    import dataclasses
-
-    from maptools.registry import Option, get_kind
+def test_the_condition_pairs_compare_a_map_with_itself_but_the_condition():
+    """Each pair differs only in the visibility condition, "off" set explicitly; the renderer's technique sits on
+    the product's bins with the kind's default."""
+    from maptools.registry import get_kind
     from wgpuviewer.studies.refined_distance import run as study
 
     kind = get_kind("distance_refined")
-    if not study.visibility_available():
-        kind = dataclasses.replace(kind, options=kind.options + (
-            Option("visibility", "off", str, "the condition", choices=("on", "off")),))
-        monkeypatch.setattr(study, "get_kind", lambda name: kind)
     named = {v.name: v for v in variants()}
     for on, off in CONDITION_PAIRS:
         a, b = dict(named[on].options), dict(named[off].options)

@@ -68,11 +68,6 @@ STORAGES = {"float16": (lambda v: uploaded_volume(v).astype(np.float64), 2), "8-
 VISIBILITY = "visibility"
 
 
-def visibility_available() -> bool:
-    """Whether maptools' distance_refined kind has the paper's visibility condition (its ``visibility`` option)."""
-    return any(o.name == VISIBILITY for o in get_kind("distance_refined").options)
-
-
 def _refined(sectors: int, bands: int, technique: str = "", visibility: str = "") -> Variant:
     """A refined-map variant; ``visibility`` "on"/"off" sets the paper's condition, "" leaves the kind's default."""
     name = "single cone" if sectors == bands == 1 else f"{sectors} sectors x {bands} bands"
@@ -105,13 +100,10 @@ CONDITION_PAIRS = ((VARIANTS[-2].name, SINGLE_CONE), (VARIANTS[-1].name, PRODUCT
 
 
 def variants() -> tuple[Variant, ...]:
-    """The variants this maptools builds: without the visibility option, those that do not name it; with it, every
-    refined one with its condition set ("off" where VARIANTS leaves it out), and the `distance_refined` technique
-    on the product's bins with the kind's default condition (what the renderer builds)."""
-    options = {o.name: o for o in get_kind("distance_refined").options}
-    if VISIBILITY not in options:
-        return tuple(v for v in VARIANTS if VISIBILITY not in v.options)
-    default = options[VISIBILITY].default
+    """The variants measured: every refined one with its condition set ("off" where VARIANTS leaves it out), and
+    the `distance_refined` technique on the product's bins with the kind's default condition (what the renderer
+    builds)."""
+    default = next(o.default for o in get_kind("distance_refined").options if o.name == VISIBILITY)
     out = []
     for v in VARIANTS:
         if v.kind != "distance_refined":
@@ -254,8 +246,7 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
 
     chosen = variants()
     format_maps = tuple(m for m in suite.format_maps if heightmaps is None or m in maps) or maps[:1]
-    steps = len(maps) * (len(chosen) + 1) + len(formats.FORMATS) + len(format_maps)
-    steps += len(pits.PLATES) if visibility_available() else 0
+    steps = len(maps) * (len(chosen) + 1) + len(formats.FORMATS) + len(format_maps) + len(pits.PLATES)
     with tempfile.TemporaryDirectory(prefix="wgpuviewer-refined-") as workdir, \
             tqdm(total=steps, desc="refined-distance", unit="step", disable=not progress) as bar:
         for name in maps:
@@ -264,17 +255,17 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
             res.donnelly += _donnelly(heightmap, chosen, suite, gpu)
             bar.update()
             write()
-        if visibility_available():
-            def plate_done(rows: list[dict]) -> None:
-                res.pits.extend(rows)
-                bar.update()
-                write()
 
-            def build(height, height_scale, **options):
-                return cached_generate("distance_refined", height, backend="auto", slices=pits.SLICES,
-                                       height_scale=height_scale, **options)
+        def plate_done(rows: list[dict]) -> None:
+            res.pits.extend(rows)
+            bar.update()
+            write()
 
-            pits.measure(suite.pit_size, suite.pit_angles, suite.pit_rays, suite.pit_budget, build, plate_done)
+        def build(height, height_scale, **options):
+            return cached_generate("distance_refined", height, backend="auto", slices=pits.SLICES,
+                                   height_scale=height_scale, **options)
+
+        pits.measure(suite.pit_size, suite.pit_angles, suite.pit_rays, suite.pit_budget, build, plate_done)
         heights = {n: formats_height(format_maps[0], n, Path(workdir)) for n in suite.format_sizes}
 
         def built(b: formats.Built) -> None:
@@ -509,8 +500,6 @@ def report(res: Results, header: Header, plotted: bool) -> str:
 def _condition_section(rows: list[dict]) -> list[str]:
     lines = ["## The paper's visibility condition", ""]
     twins = _twins(rows)
-    if not any(r["variant"] == CONDITION_PAIRS[0][0] for r in twins):
-        return lines + [f"Not measured: this maptools' `distance_refined` kind has no `{VISIBILITY}` option.", ""]
     lines += ["Fetches with the condition over the same map without it (mean / SIMD-tile), per view angle: "
               "single cone (sectors 1 x bands 1, the paper's map) and the binned map (the product's bins).", "",
               "| height map | angle | single cone: on vs off | binned: on vs off |", "|---|---|---|---|"]
