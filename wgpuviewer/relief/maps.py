@@ -379,25 +379,32 @@ def _auto_table(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str, pr
     return autotable.table_texture(gpu, autotable.measure(depth, height_scale, probe), label)
 
 
+def uploaded_volume(volume: np.ndarray) -> np.ndarray:
+    """A distance volume as the renderer uploads it: float16, every value rounded down (a step never grows, so
+    the map stays safe). For the plain map this halves its memory; the refined-distance study measures the cost
+    within +-0.2 % of the fetches (docs/maps.md). The refined kind is float16 already."""
+    if volume.dtype == np.float16:
+        return volume
+    return distance_kind.round_down(np.asarray(volume, np.float64), np.float16)
+
+
 def _volume_texture(gpu: Gpu, volume: np.ndarray, label: str) -> wgpu.GPUTexture:
-    """A (Dz, H, W) float32 volume as an r32float 3D texture, or (V, Dz, H, W) float16 volumes stacked along the
-    depth as r16float (volume v at depths [v Dz, (v + 1) Dz)); uploaded one depth layer at a time (no staging
-    copy of the whole volume)."""
-    half = volume.dtype == np.float16
+    """A (Dz, H, W) volume, or (V, Dz, H, W) volumes stacked along the depth (volume v at depths [v Dz, (v + 1) Dz)),
+    as an r16float 3D texture (``uploaded_volume``); converted and uploaded one depth layer at a time (no copy of
+    the whole volume)."""
     h, w = volume.shape[-2:]
     depth = volume.size // (w * h)
-    item = 2 if half else 4
-    with allocating(gpu, label, w * h * depth * item, "use a smaller height map"):
+    with allocating(gpu, label, w * h * depth * 2, "use a smaller height map"):
         texture = gpu.device.create_texture(
-            label=label, size=(w, h, depth), dimension="3d", format="r16float" if half else "r32float",
+            label=label, size=(w, h, depth), dimension="3d", format="r16float",
             usage=wgpu.TextureUsage.TEXTURE_BINDING | wgpu.TextureUsage.COPY_DST,
         )
     layers = volume.reshape(depth, h, w)
     for z in range(depth):
         gpu.device.queue.write_texture(
             {"texture": texture, "mip_level": 0, "origin": (0, 0, z)},
-            np.ascontiguousarray(layers[z], np.float16 if half else np.float32),
-            {"offset": 0, "bytes_per_row": w * item, "rows_per_image": h}, (w, h, 1),
+            np.ascontiguousarray(uploaded_volume(layers[z])),
+            {"offset": 0, "bytes_per_row": w * 2, "rows_per_image": h}, (w, h, 1),
         )
     return texture
 
@@ -410,20 +417,11 @@ def _planned(gpu: Gpu, kind: str, depth: np.ndarray, label: str) -> VolumePlan:
     return plan
 
 
-def uploaded_volume(volume: np.ndarray) -> np.ndarray:
-    """A distance volume as the renderer uploads it: float16, every value rounded down (a step never grows, so
-    the map stays safe). For the plain map this halves its memory; the refined-distance study measures the cost
-    within +-0.2 % of the fetches (docs/maps.md). The refined kind is float16 already."""
-    if volume.dtype == np.float16:
-        return volume
-    return distance_kind.round_down(np.asarray(volume, np.float64), np.float16)
-
-
 def _distance(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
     plan = _planned(gpu, "distance", depth, label)
     volume = cached_generate("distance", 1.0 - depth, backend="auto", slices=plan.slices, subcells=plan.subcells,
                              height_scale=height_scale)
-    return _volume_texture(gpu, uploaded_volume(volume), label)
+    return _volume_texture(gpu, volume, label)
 
 
 def _distance_refined(gpu: Gpu, depth: np.ndarray, height_scale: float, label: str) -> wgpu.GPUTexture:
