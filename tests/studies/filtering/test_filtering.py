@@ -23,7 +23,6 @@ from wgpuviewer.studies.filtering.suites import (
     TABLE,
     TUNING_CONFIGS,
     Config,
-    inherit_available,
     resolve_options,
 )
 from wgpuviewer.studies.filtering.views import (
@@ -313,8 +312,7 @@ def test_smoke_suite_end_to_end(tmp_path, gpu):
     labels = {r["label"] for r in rows}
     assert {"trilinear (uv)", "bilinear (uv)", "aniso 16 (uv)", "ewa (displaced)", "ewa_vis (displaced)",
             "ewa_vis_rows (displaced)", "trilinear (uv) [pom32]", "ewa_vis (displaced) [pom32]"} <= labels
-    if inherit_available():
-        assert "ewa_vis inherit=1 (displaced)" in labels
+    assert "ewa_vis inherit=1 (displaced)" in labels
     probe_honours = explicit_gradient_support(gpu)
     for r in rows:
         assert np.isfinite(r["psnr"]) and 0.0 < r["ssim"] <= 1.0 and r["time_ratio"] > 0 and r["pixels"] > 0

@@ -75,12 +75,9 @@ def void_reason(config: Config, gpu) -> str:
     kind = EXPLICIT_GRADIENTS.get(config.filter)
     if kind is None:
         return ""
-    from wgpuviewer.relief.filter_probe import explicit_gradient_note, explicit_gradient_probe
+    from wgpuviewer.relief.filter_probe import explicit_gradient_note
 
-    ignored = explicit_gradient_probe(gpu).ignored
-    # the probe names what is ignored per sampler: "... with an isotropic sampler", "... anisotropic sampler ..."
-    hit = [p for p in ignored if ("anisotropic" in p) == (kind == "anisotropic")]
-    return explicit_gradient_note(gpu) if hit else ""
+    return explicit_gradient_note(gpu, kind)
 
 
 @dataclass

@@ -51,12 +51,6 @@ BILINEAR = Config("bilinear")  # level 0 at the hit: no footprint at all
 EXPLICIT_GRADIENTS = {"trilinear": "isotropic", "aniso": "anisotropic"}
 
 
-def inherit_available() -> bool:
-    """Whether the visibility filters have the ``inherit`` weighting parameter (the substitute, the texel the ray
-    towards a hidden texel meets, takes its weight) besides dropping."""
-    return any(p.name == "inherit" for p in get_filter("ewa_vis").params)
-
-
 def _visibility_configs(tracer: str = EXACT) -> list[Config]:
     """The visibility filters on the two traced footprints (the paper's is the displaced one), dropping hidden
     texels; the full method also with the substitute inheriting their weight, the row-ends one on displaced."""
@@ -64,9 +58,8 @@ def _visibility_configs(tracer: str = EXACT) -> list[Config]:
     for name in ("ewa_vis", "ewa_vis_rows"):
         for source in ("displaced", "analytic"):
             out.append(Config(name, source, tracer=tracer))
-    if inherit_available():
-        out += [Config("ewa_vis", s, (("inherit", 1),), tracer) for s in ("displaced", "analytic")]
-        out.append(Config("ewa_vis_rows", "displaced", (("inherit", 1),), tracer))
+    out += [Config("ewa_vis", s, (("inherit", 1),), tracer) for s in ("displaced", "analytic")]
+    out.append(Config("ewa_vis_rows", "displaced", (("inherit", 1),), tracer))
     return out
 
 
@@ -86,9 +79,7 @@ def _full_configs() -> tuple[Config, ...]:
     out.append(Config("ewa", "analytic", (("alpha", 2.0),)))
     out += _visibility_configs()
     approximate = [BASELINE, BILINEAR, Config("ewa", "displaced"), Config("ewa", "analytic"),
-                   Config("ewa_vis", "displaced")]
-    if inherit_available():
-        approximate.append(Config("ewa_vis", "displaced", (("inherit", 1),)))
+                   Config("ewa_vis", "displaced"), Config("ewa_vis", "displaced", (("inherit", 1),))]
     out += [c.on("pom32") for c in approximate]
     return tuple(out)
 
@@ -98,9 +89,8 @@ def _smoke_configs() -> tuple[Config, ...]:
     the visibility filters with the two traced sources (inherit on displaced), two of them after POM."""
     out = [BASELINE, BILINEAR, Config("aniso", "uv", (("max_anisotropy", 16),)), Config("ewa", "uv"),
            Config("ewa", "displaced"), Config("ewa", "analytic"), Config("ewa_vis", "displaced"),
-           Config("ewa_vis", "analytic"), Config("ewa_vis_rows", "displaced")]
-    if inherit_available():
-        out.append(Config("ewa_vis", "displaced", (("inherit", 1),)))
+           Config("ewa_vis", "analytic"), Config("ewa_vis_rows", "displaced"),
+           Config("ewa_vis", "displaced", (("inherit", 1),))]
     return tuple(out + [BASELINE.on("pom32"), Config("ewa_vis", "displaced", tracer="pom32")])
 
 
