@@ -111,10 +111,10 @@ def test_view_without_display_renders_a_png(tmp_path, adapter):
 
 
 def test_every_study_folder_is_a_registered_subcommand():
-    """A folder under wgpuviewer/studies/ is a command without any list to edit: the harness finds it."""
+    """A folder under wgpuviewer/lab/studies/ is a command without any list to edit: the harness finds it."""
     from wgpuviewer import cli
 
-    folders = sorted(p.name for p in (ROOT / "wgpuviewer" / "studies").iterdir() if (p / "__init__.py").is_file())
+    folders = sorted(p.name for p in (ROOT / "wgpuviewer" / "lab" / "studies").iterdir() if (p / "__init__.py").is_file())
     assert folders  # filtering, perspective, refined_distance, ...
     _, commands = cli.build_parser()
     for folder in folders:
@@ -123,7 +123,7 @@ def test_every_study_folder_is_a_registered_subcommand():
 
 
 def test_a_discovered_study_runs_with_the_shared_options_and_its_command_line(monkeypatch, capsys, tmp_path):
-    from wgpuviewer.harness import study as harness_study
+    from wgpuviewer.lab.harness import study as harness_study
 
     seen = {}
 

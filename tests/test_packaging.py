@@ -56,7 +56,7 @@ def test_wheel_lists_every_package_wgsl_file_and_scene(installed):
                 for p in (ROOT / room).rglob("__init__.py")}
     expected |= {"wgpuviewer/" + p.relative_to(ROOT).as_posix() for p in (ROOT / "wgsl").rglob("*.wgsl")}
     expected |= {"wgpuviewer/" + p.relative_to(ROOT).as_posix() for p in (ROOT / "scenes").glob("*.toml")}
-    assert {"wgpuviewer/studies/refined_distance/__init__.py", "wgpuviewer/harness/__init__.py"} <= expected
+    assert {"wgpuviewer/lab/studies/refined_distance/__init__.py", "wgpuviewer/lab/harness/__init__.py"} <= expected
     assert not expected - names, f"missing from the wheel: {sorted(expected - names)}"
 
 

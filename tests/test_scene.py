@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.relief.techniques import TECHNIQUES
 from wgpuviewer.scene import (
     DEFAULT_LIGHT,
     Scene,
@@ -18,6 +17,7 @@ from wgpuviewer.scene import (
     load_scene,
     parse_scene,
 )
+from wgpuviewer.techniques import TECHNIQUES
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 

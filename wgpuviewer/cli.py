@@ -1,5 +1,5 @@
 """Command line: ``wgpuviewer view|render|warm|techniques|filters|accuracy|info`` here, and the measuring commands:
-``bench`` and every study under ``wgpuviewer/studies/`` (found by the harness, each registering itself)."""
+``bench`` and every study under ``wgpuviewer/lab/studies/`` (found by the harness, each registering itself)."""
 
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ def load_scene_arg(path: str | None):
 
 
 def pick_technique(scene, name: str | None) -> str:
-    from wgpuviewer.relief.techniques import get_technique
+    from wgpuviewer.techniques import get_technique
 
     return get_technique(name or scene.technique, "--technique").name
 
@@ -224,7 +224,7 @@ def view_offscreen(args, scene, technique: str, filtering: dict, size: tuple[int
 
 
 def cmd_techniques(args) -> int:
-    from wgpuviewer.relief.techniques import TECHNIQUES
+    from wgpuviewer.techniques import TECHNIQUES
 
     for t in TECHNIQUES.values():
         print(f"{t.key}  {t.name:<10} needs: {', '.join(t.textures):<22} cost: {t.cost}")
@@ -319,8 +319,8 @@ def cmd_warm(args) -> int:
     per technique, exit 1 when one could not be built."""
     from maptools.cache import cache_dir
     from wgpuviewer.core.gpu import get_gpu
-    from wgpuviewer.relief.techniques import TECHNIQUES, get_technique
     from wgpuviewer.relief.warm import warm
+    from wgpuviewer.techniques import TECHNIQUES, get_technique
 
     if args.scene and Path(args.scene).is_dir():  # SCENE|DIR: a folder is a material folder on the default scene
         if args.material:
@@ -364,15 +364,15 @@ def add_filter_options(parser) -> None:
 
 def measurement_commands() -> list:
     """bench, then every study folder's ``STUDY`` (the harness finds them)."""
-    from wgpuviewer.bench import STUDY as BENCH
-    from wgpuviewer.harness.study import discover
+    from wgpuviewer.lab.bench import STUDY as BENCH
+    from wgpuviewer.lab.harness.study import discover
 
     return [BENCH, *discover()]
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
     """The parser and the names of its commands."""
-    from wgpuviewer.harness.study import register
+    from wgpuviewer.lab.harness.study import register
     from wgpuviewer.relief.output import MODE_DESCRIPTIONS, OUTPUT_MODES
 
     parser = OneLineParser(

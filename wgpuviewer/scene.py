@@ -21,7 +21,7 @@ import numpy as np
 from wgpuviewer.core.errors import FileError, UserError
 from wgpuviewer.core.images import read_header
 from wgpuviewer.core.sidecar import file_sha256, is_recorded, read_record
-from wgpuviewer.relief.techniques import TECHNIQUES, get_technique, resolve_params
+from wgpuviewer.techniques import TECHNIQUES, get_technique, resolve_params
 
 from . import camera as cam
 from .meshes import BUILTIN_SHAPES, MESH_SUFFIXES, NodeNotFound, load_mesh

@@ -14,7 +14,7 @@ from maptools import cone as cn
 from maptools import distance as dist
 from maptools import refined as rf
 from tests.maptools.helpers import adversarial_maps, smooth_tileable
-from wgpuviewer.studies.refined_distance import reliefs
+from wgpuviewer.lab.studies.refined_distance import reliefs
 
 #: Small adversarial maps (flat, spike, step, wall, checker, 1x1, NPOT and odd sizes, 8/16-bit) and one non-square one.
 MAPS = {name: h for name, h in adversarial_maps().items() if h.size <= 4000}

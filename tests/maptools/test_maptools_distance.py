@@ -19,8 +19,8 @@ from maptools.trace import sphere_trace
 from tests.maptools.helpers import adversarial_maps, smooth_tileable
 from wgpuviewer.core.compute import Compute
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.lab.studies.refined_distance import reliefs
 from wgpuviewer.relief.reference import exact_hit, sample_bilinear, view_dir_from_angles
-from wgpuviewer.studies.refined_distance import reliefs
 
 RNG = np.random.default_rng(1234)
 

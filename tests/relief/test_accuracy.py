@@ -15,7 +15,7 @@ from wgpuviewer.relief.accuracy import (
     shadow_run,
     simd_tile_cost,
 )
-from wgpuviewer.relief.techniques import TECHNIQUES
+from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.textures import builtin_height
 
 

@@ -14,8 +14,8 @@ from wgpuviewer.relief.output import mode_data
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
 from wgpuviewer.relief.renderer import Renderer
-from wgpuviewer.relief.techniques import AUTO_BINS, AUTO_CANDIDATES, AUTO_TAN0, TECHNIQUES
 from wgpuviewer.scene import load_scene
+from wgpuviewer.techniques import AUTO_BINS, AUTO_CANDIDATES, AUTO_TAN0, TECHNIQUES
 from wgpuviewer.textures import builtin_height
 
 from .test_render import GOLDEN

@@ -16,7 +16,7 @@ from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
 from wgpuviewer.relief.maps import MAP_SLOTS, footprint_min_depth
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
-from wgpuviewer.relief.techniques import (
+from wgpuviewer.techniques import (
     CONE_FILTER,
     CONE_FINISH_CELLS,
     CONE_HALVINGS_MAX,

@@ -1,5 +1,5 @@
 """Texture filters: the registry and its generated interface, the WGSL filters against their float64 twins
-(wgpuviewer.studies.filtering.cpu) on the same footprints, visibility on a step, degenerate footprints."""
+(wgpuviewer.lab.studies.filtering.cpu) on the same footprints, visibility on a step, degenerate footprints."""
 
 from __future__ import annotations
 
@@ -10,11 +10,11 @@ import pytest
 
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.wgsl import read_wgsl
+from wgpuviewer.lab.studies.filtering import cpu
 from wgpuviewer.relief import filters
 from wgpuviewer.relief.filter_probe import filter_probe, texture_levels
 from wgpuviewer.relief.filters import FILTERS, FLAGS
 from wgpuviewer.relief.reference import exact_hit, view_dir_from_angles
-from wgpuviewer.studies.filtering import cpu
 from wgpuviewer.textures import builtin_albedo, builtin_height
 
 CONTRACT = ("nearest", "bilinear", "trilinear", "aniso", "ewa", "ewa_approx", "ewa_vis", "ewa_vis_rows")

@@ -1,6 +1,6 @@
 """The visibility filters' ``inherit`` weighting: a hidden texel's weight goes to its substitute (the texel its ray
 meets) when that lies outside the footprint ellipse. The WGSL (wgsl/common/ewa.wgsl, visibility/traced.wgsl)
-against its float64 twin (wgpuviewer.studies.filtering.cpu) through the filter probe, on real and adversarial
+against its float64 twin (wgpuviewer.lab.studies.filtering.cpu) through the filter probe, on real and adversarial
 footprints; ``inherit`` 0 is the drop convention, unchanged."""
 
 from __future__ import annotations
@@ -10,10 +10,10 @@ import pytest
 
 from tests.relief.test_filters import DEGENERATE, footprints, gpu_and_cpu, near_tolerance, step_case, textures
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.lab.studies.filtering import cpu
 from wgpuviewer.relief.filter_probe import filter_probe
 from wgpuviewer.relief.filters import FILTERS, filter_interface, resolve_filter_params
 from wgpuviewer.relief.reference import view_dir_from_angles
-from wgpuviewer.studies.filtering import cpu
 from wgpuviewer.textures import builtin_height
 
 VISIBILITY = [name for name, f in FILTERS.items() if f.visibility]

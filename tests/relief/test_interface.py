@@ -19,8 +19,8 @@ from wgpuviewer.core.wgsl import read_wgsl
 from wgpuviewer.relief import filter_probe, maps, probe, renderer, shaders
 from wgpuviewer.relief.maps import MAP_SLOTS, MapSlot
 from wgpuviewer.relief.renderer import Renderer
-from wgpuviewer.relief.techniques import TECHNIQUES, Param, Technique
 from wgpuviewer.scene import parse_scene
+from wgpuviewer.techniques import TECHNIQUES, Param, Technique
 from wgpuviewer.viewer import error_view
 
 #: Every entry file and the records Python generates for it (composed in before it: the entry never declares them).

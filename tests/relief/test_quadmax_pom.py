@@ -10,7 +10,7 @@ from tests.relief.twins import pom_from
 from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
 from wgpuviewer.relief.maps import depth_range
 from wgpuviewer.relief.probe import probe
-from wgpuviewer.relief.techniques import AUTO_CANDIDATES, TECHNIQUES
+from wgpuviewer.techniques import AUTO_CANDIDATES, TECHNIQUES
 from wgpuviewer.textures import builtin_height
 
 S = 0.05

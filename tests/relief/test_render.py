@@ -10,8 +10,8 @@ import pytest
 
 from wgpuviewer.relief.output import mode_data, mode_picture
 from wgpuviewer.relief.renderer import OFFSCREEN_FORMATS, Renderer
-from wgpuviewer.relief.techniques import TECHNIQUES
 from wgpuviewer.scene import default_scene_path, load_scene
+from wgpuviewer.techniques import TECHNIQUES
 
 ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = Path(__file__).parent / "golden"

@@ -11,8 +11,8 @@ from tests.relief.scenes import material_scene
 from wgpuviewer.relief import reference as ref
 from wgpuviewer.relief.probe import shadow_probe
 from wgpuviewer.relief.renderer import Renderer
-from wgpuviewer.relief.techniques import get_technique
 from wgpuviewer.scene import parse_scene
+from wgpuviewer.techniques import get_technique
 from wgpuviewer.textures import builtin_height
 
 #: Grid points per texel of the probe grids (the edge band below is one texel wide, in grid points).

@@ -20,7 +20,8 @@ from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.relief.shaders import pack_trace_params, trace_params
-from wgpuviewer.relief.techniques import (
+from wgpuviewer.scene import default_scene_path, load_scene, parse_scene
+from wgpuviewer.techniques import (
     HANDOVER_STEPS,
     PYRAMID_STEPS,
     REFINED_BANDS,
@@ -29,7 +30,6 @@ from wgpuviewer.relief.techniques import (
     TECHNIQUES,
     Fixed,
 )
-from wgpuviewer.scene import default_scene_path, load_scene, parse_scene
 from wgpuviewer.textures import builtin_height
 
 REAL = ("bricks", "bumps", "ridges")
@@ -267,7 +267,7 @@ def test_layers_mode_shows_the_adaptive_layer_count(scene_renderer):
 
 def test_cost_scale_bounds_each_search():
     """The cost view's full heat: the fetch bound of layer searches, a common scale otherwise."""
-    from wgpuviewer.relief.techniques import COMMON_COST_SCALE, TECHNIQUES
+    from wgpuviewer.techniques import COMMON_COST_SCALE, TECHNIQUES
 
     assert TECHNIQUES["pom"].cost_scale({"layers": 32}) == 33
     assert TECHNIQUES["pom_adaptive"].cost_scale(TECHNIQUES["pom_adaptive"].defaults()) == 33
@@ -277,7 +277,7 @@ def test_cost_scale_bounds_each_search():
 
 def _cost_scale_by_parameter_names(params: dict) -> float:
     """The cost view's scale as it was once inferred from parameter names (frozen: the entries keep its values)."""
-    from wgpuviewer.relief.techniques import COMMON_COST_SCALE
+    from wgpuviewer.techniques import COMMON_COST_SCALE
 
     if "layers" in params:
         return float(params["layers"] + 1)
@@ -290,7 +290,7 @@ def _cost_scale_by_parameter_names(params: dict) -> float:
 
 def _layer_range_by_parameter_names(params: dict) -> tuple[float, float]:
     """The layers view's range as it was once inferred from parameter names (frozen, as above)."""
-    from wgpuviewer.relief.techniques import AUTO_CANDIDATES
+    from wgpuviewer.techniques import AUTO_CANDIDATES
 
     if "max_error" in params:
         return 1.0, float(len(AUTO_CANDIDATES))
@@ -302,7 +302,7 @@ def _layer_range_by_parameter_names(params: dict) -> tuple[float, float]:
 def test_cost_and_layer_views_keep_their_scales():
     """Each entry's own cost_scale and layer_range give what the parameter names once gave, for its defaults,
     contract parameters and accuracy settings."""
-    from wgpuviewer.relief.techniques import resolve_params
+    from wgpuviewer.techniques import resolve_params
 
     for t in TECHNIQUES.values():
         for overrides in ({}, *t.contract_params, *t.accuracy_settings):
@@ -413,7 +413,7 @@ def test_trace_params_fields_have_their_declared_types():
 
 def test_markdown_table_has_a_row_per_technique():
     """The README's technique table, generated from the registry: one row per entry, in registry order."""
-    from wgpuviewer.relief.techniques import markdown_table
+    from wgpuviewer.techniques import markdown_table
 
     header, rule, *rows = markdown_table().split("\n")
     assert header == "| key | name | needs | what it costs (fetches per ray) | parameters |" and rule == "|---|---|---|---|---|"

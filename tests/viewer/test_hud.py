@@ -13,7 +13,7 @@ import pytest
 from imgui_bundle import imgui
 
 from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS
-from wgpuviewer.relief.techniques import TECHNIQUES
+from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.viewer.hud import font_path, summary_line
 from wgpuviewer.viewer.keys import CONTROLS
 from wgpuviewer.viewer.state import ViewerState

@@ -188,7 +188,7 @@ def test_gpu_timer_reads_back_pass_times_without_blocking(gpu, scene):
 
 
 def test_hud_lines_say_what_auto_chooses(gpu):
-    from wgpuviewer.relief.techniques import AUTO_CANDIDATES
+    from wgpuviewer.techniques import AUTO_CANDIDATES
     from wgpuviewer.viewer.hud import auto_lines
 
     scene = load_scene(os.path.join(os.path.dirname(__file__), "..", "relief", "golden", "scene.toml"))

@@ -7,7 +7,7 @@ import subprocess
 import sys
 
 from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS
-from wgpuviewer.relief.techniques import TECHNIQUES
+from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.viewer.keys import PRESSED, TECHNIQUE_KEYS
 from wgpuviewer.viewer.state import Half, ViewerState
 

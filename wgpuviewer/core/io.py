@@ -1,6 +1,6 @@
 """Atomic file writes: every output of the project (renders, maps, reports, settings, caches) goes through
 ``atomic_open``, so a reader never sees a partial file, even after ``kill -9`` or a full disk (the results tables
-of bench and the studies too: ``wgpuviewer.harness.table``).
+of bench and the studies too: ``wgpuviewer.lab.harness.table``).
 
 Every way a write can fail that the user can fix (the path is a folder, the disk is full, the folder is read-only
 or not ours, a parent is a file) is a one-line ``UserError`` naming the path and the fix; nothing is left behind.

@@ -17,10 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from wgpuviewer.core.errors import InputError
+from wgpuviewer.techniques import TECHNIQUES, get_technique, resolve_params
 
 from .probe import probe, shadow_probe
 from .reference import Hit, exact_hit, real_array, real_number, shadow, uv_error_texels, view_dir_from_angles
-from .techniques import TECHNIQUES, get_technique, resolve_params
 
 
 @dataclass
@@ -251,7 +251,7 @@ def markdown_report(measured: Run, command: str, adapter: str, date: str | None 
         "samples; for the map-based tracers their map's texels and 2x2 gathers, see the technique table in the "
         "README). Rays flagged *capped* (a view with V.z < 1e-4, a step cap reached) are excluded from the errors; "
         "their share follows where there are any. The settings are each technique's `accuracy_settings` in "
-        "`relief/techniques.py` (params: the overrides of its defaults, `-` for none).",
+        "`wgpuviewer/techniques/` (params: the overrides of its defaults, `-` for none).",
     ]
     header = "| technique | params | " + " | ".join(f"{angle:g}°" for angle in measured.angles) + " |"
     rule = "|---|---|" + "---|" * len(measured.angles)

@@ -36,9 +36,7 @@ import numpy as np
 from maptools.cache import cache_key, cached
 from wgpuviewer.core.gpu import Gpu, create_texture
 from wgpuviewer.core.wgsl import compose
-
-from .reference import exact_hit, uv_error_texels, view_dir_from_angles
-from .techniques import (
+from wgpuviewer.techniques import (
     AUTO_BINS,
     AUTO_BINS_PER_OCTAVE,
     AUTO_BUDGET_LEVELS,
@@ -48,6 +46,8 @@ from .techniques import (
     AUTO_TAN0,
     TECHNIQUES,
 )
+
+from .reference import exact_hit, uv_error_texels, view_dir_from_angles
 
 #: Bump when what ``measure`` computes changes (cached tables are then measured again).
 VERSION = 5

@@ -3,7 +3,7 @@
 The probe composes the same filter (and, for the visibility filters, the same technique ``trace``) the fragment
 shader uses (``shaders.compose_technique(..., "filter_probe", filter)``), over a texture uploaded as the renderer
 uploads albedo (rgba16float, box-filtered mip chain). Tests compare it with the float64 filters of
-``wgpuviewer.studies.filtering.cpu`` on the same footprints, including ones no render produces (zero, NaN and
+``wgpuviewer.lab.studies.filtering.cpu`` on the same footprints, including ones no render produces (zero, NaN and
 huge derivatives).
 
 ``explicit_gradient_support(gpu)`` asks the adapter whether it honours ``textureSampleGrad``'s explicit gradients
@@ -22,12 +22,12 @@ from wgpuviewer.core.compute import Kernel, compute_for
 from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, get_gpu, mip_chain
 from wgpuviewer.core.structs import Struct
+from wgpuviewer.techniques import get_technique, resolve_params
 
 from .filters import FILTER_GROUP, get_filter, pack_filter_params, resolve_filter_params, sampler_descriptor
 from .maps import binding
 from .probe import FEWER, FIX, dispatch, io_layout_entries, material_bind_group, material_layout_entries
 from .shaders import compose_technique
-from .techniques import get_technique, resolve_params
 
 #: The filter probe's records (entry/filter_probe.wgsl binds an array of each and declares neither): a footprint
 #: in (view: V in tangent space, for visibility traces); the filtered value and the filter's statistics out.

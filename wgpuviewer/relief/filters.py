@@ -18,8 +18,7 @@ from dataclasses import dataclass
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.structs import Struct, f32_literal, range_constants, scalar_uniform
 from wgpuviewer.core.wgsl import Generated
-
-from .techniques import Param, Parametrized, resolve_params
+from wgpuviewer.techniques import Param, Parametrized, resolve_params
 
 #: The default filter and derivative source: hardware trilinear on the unperturbed uv: the plain hardware lookup.
 DEFAULT_FILTER = "trilinear"
@@ -58,7 +57,7 @@ class Filter(Parametrized):
     #: Takes derivatives: nearest and bilinear read level 0 and ignore them.
     uses_derivatives: bool = True
     #: Largest |GPU - float64 twin| of a filtered value on the same footprints (the twin:
-    #: ``wgpuviewer.studies.filtering.cpu.cpu_filter``; tests/relief/test_filters.py holds every filter to it).
+    #: ``wgpuviewer.lab.studies.filtering.cpu.cpu_filter``; tests/relief/test_filters.py holds every filter to it).
     twin_tolerance: float | None = None
     #: Why the filter has no twin (then ``twin_tolerance`` is None): every filter has one or the other.
     no_twin: str = ""

@@ -32,9 +32,9 @@ from maptools.cpu import level_sizes
 from wgpuviewer.core.compute import compute_for
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import Gpu, allocating, check_texture_size, create_texture, format_bytes, mip_chain
+from wgpuviewer.techniques import CONE_FILTER, CONE_MAX_RATIO, REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 
 from . import autotable
-from .techniques import CONE_FILTER, CONE_MAX_RATIO, REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 
 log = logging.getLogger(__name__)
 

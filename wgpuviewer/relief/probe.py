@@ -26,11 +26,11 @@ from wgpuviewer.core.compute import Kernel, compute_for
 from wgpuviewer.core.errors import InputError
 from wgpuviewer.core.gpu import Gpu, get_gpu
 from wgpuviewer.core.structs import Struct
+from wgpuviewer.techniques import TECHNIQUES, get_technique, resolve_params
 
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
 from .reference import real_array, real_number
 from .shaders import compose_technique, pack_trace_params
-from .techniques import TECHNIQUES, get_technique, resolve_params
 
 #: The probe's records (entry/probe.wgsl binds an array of each and declares neither): a ray in, its hit out.
 PROBE_RAY = Struct("ProbeRay", [("uv", "vec2f"), ("view", "vec3f")], "storage")  # view: V in tangent space

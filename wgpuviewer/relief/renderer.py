@@ -29,6 +29,7 @@ from wgpuviewer.core.images import read_header
 from wgpuviewer.core.structs import FragmentOutputs
 from wgpuviewer.core.wgsl import Generated
 from wgpuviewer.scene import SHADOW_MODES, Camera, Scene
+from wgpuviewer.techniques import Technique, get_technique, resolve_params
 
 from . import autotable
 from .filters import (
@@ -55,7 +56,6 @@ from .shaders import (
     trace_params_size,
     traces_relief,
 )
-from .techniques import Technique, get_technique, resolve_params
 
 COLOR_FORMAT = "rgba8unorm-srgb"  # offscreen colour: shaders write linear, PNGs get sRGB bytes
 DATA_FORMAT = "rgba32uint"  # offscreen raw trace data (float bits): hit u, v, depth, fetches

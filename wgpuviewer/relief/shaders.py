@@ -20,11 +20,11 @@ from dataclasses import dataclass
 from wgpuviewer.core.structs import Struct, array, range_constants, scalar_uniform
 from wgpuviewer.core.wgsl import Generated, Module, compose
 from wgpuviewer.scene import MAX_LIGHTS
+from wgpuviewer.techniques import MAX_LAYERS, Technique
 
 from .filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, filter_interface, get_derivatives, get_filter
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding
 from .reference import SHADOW_TOLERANCE_TEXELS, SOFT_SHADOW_PENUMBRA, SOFT_SHADOW_SAMPLES
-from .techniques import MAX_LAYERS, Technique
 
 #: The render entry's uniforms (``entry/render.wgsl``): group 0's Frame (camera, view mode, lights; MAX_LIGHTS, the
 #: scene format's limit, sizes its light array) and group 2's Object, generated into the render interface.

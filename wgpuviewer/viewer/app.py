@@ -35,8 +35,8 @@ from wgpuviewer.core.gpu import get_gpu
 from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, FILTERS, get_filter
 from wgpuviewer.relief.output import save_rgb_png
 from wgpuviewer.relief.renderer import DrawConfig, Renderer
-from wgpuviewer.relief.techniques import get_technique
 from wgpuviewer.scene import Scene
+from wgpuviewer.techniques import get_technique
 
 from . import runner
 from .builds import Builds

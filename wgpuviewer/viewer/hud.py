@@ -27,7 +27,7 @@ from wgpuviewer.core.color import heat, linear_to_srgb
 from wgpuviewer.relief import autotable
 from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS, get_filter
 from wgpuviewer.relief.maps import height_scale_adjustable
-from wgpuviewer.relief.techniques import get_technique
+from wgpuviewer.techniques import get_technique
 
 from .keys import CONTROLS
 

@@ -18,7 +18,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.relief.techniques import TECHNIQUES, get_technique
+from wgpuviewer.techniques import TECHNIQUES, get_technique
 
 #: Number key -> the technique it picks (techniques whose key is "-" are reached with the arrows).
 TECHNIQUE_KEYS = {t.key: name for name, t in TECHNIQUES.items() if t.key != "-"}
