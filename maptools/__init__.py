@@ -1,7 +1,9 @@
 """Map generation for relief mapping: normal, complexity, maximum-pyramid and 3D distance maps from height maps.
 
-Each kind has a WGSL compute kernel (``wgsl/maps/``), a CPU implementation (OpenCV/numpy) that is
-both the fallback and the cross-check, and an entry in :data:`maptools.registry.KINDS`.
+Each kind is one folder ``maptools/kinds/KIND/``: its entry (``KIND``, found by :data:`maptools.registry.KINDS`), its
+WGSL compute kernel, a CPU implementation (OpenCV/numpy) that is both the fallback and the cross-check, and the
+renderer's texture slots built from it (``slot.py``). Shared once: the registry's types, the GPU runner (``gpu``),
+the plain distance volume both distance kinds build (``volume``), the CLI, cache, check and I/O.
 
 Conventions: heights are float32 (H, W) in [0, 1], 1 = top; columns are u (x, right), rows are v with
 row 0 = v near 0 (v increases with the row index).
@@ -20,8 +22,9 @@ from .io import validate_height
 
 __all__ = ["generate", "validate_height", "resolve_backend", "VERSION", "KINDS"]
 
-#: Version of the CPU reference implementations (``maptools/*.py``): part of every cache key, next to the hash of
-#: the kind's composed kernel source (which tracks the GPU path by itself); bump it when a CPU output changes.
+#: Version of the CPU reference implementations (the kinds' ``cpu.py``, ``volume/cpu.py``): part of every cache key,
+#: next to the hash of the kind's composed kernel source (which tracks the GPU path by itself); bump it when a CPU
+#: output changes.
 VERSION = "maptools-3"
 
 _notice_printed = False

@@ -11,30 +11,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import cone as cn
-from . import distance as dist
-from . import refined as rf
-from .registry import Comparison, get_kind
+from .registry import Comparison, all_kinds, get_kind
 
 
-@dataclass(frozen=True)
-class SampledReference:
-    """A kind's CPU reference at given values: ``values(height, index, **opts)`` is exactly
-    ``kind.cpu(height, **opts)[index]`` for a tuple of integer index arrays, without computing the whole map;
-    ``shape(height_shape, opts)`` is the whole map's shape (the GPU map must have it)."""
-
-    values: Callable[..., np.ndarray]
-    shape: Callable[[tuple[int, int], dict], tuple[int, ...]]
+def sampled_kinds() -> list[str]:
+    """The kinds whose CPU reference is sampled by default (``Kind.sampled``)."""
+    return [name for name, kind in all_kinds().items() if kind.sampled is not None]
 
 
-#: The kinds whose CPU reference is sampled by default.
-SAMPLED: dict[str, SampledReference] = {
-    "distance": SampledReference(dist.sample_reference, lambda hw, o: (o["slices"], *hw)),
-    "cone": SampledReference(cn.sample_reference, lambda hw, o: hw),
-    "distance_refined": SampledReference(
-        rf.sample_reference, lambda hw, o: (rf.check(hw[1], hw[0], o["slices"], o["sectors"], o["bands"]),
-                                            o["slices"], *hw)),
-}
 #: Values sampled per sampled kind by default: on a 512^2 map each sampled CPU reference then takes 1-2 s on 2 cores
 #: (distance 1.6 s, cone 0.9 s on camera.png), against 43 s and 13 s for the whole references.
 DEFAULT_SAMPLE = 4096
@@ -82,7 +66,7 @@ def check_kind(name: str, height: np.ndarray, opts: dict, sample: int | None, se
     gpu_map = kind.gpu(height, **opts)
     gpu_s = time.perf_counter() - t0
     total = value_count(gpu_map)
-    sampled = SAMPLED.get(name) if sample is not None and sample < total else None
+    sampled = kind.sampled if sample is not None and sample < total else None
     progress("CPU sample" if sampled else "CPU")
     t0 = time.perf_counter()
     if sampled is None:

@@ -7,7 +7,6 @@ Exit codes: 0 success, 1 a batch job or a check failed, 2 a user error (one line
 from __future__ import annotations
 
 import argparse
-import functools
 import hashlib
 import json
 import sys
@@ -16,14 +15,14 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from wgpuviewer.core.cli import OneLineParser, prepare_process, run_command, save_traceback, terminal_progress
+from wgpuviewer.core.commands import OneLineParser, prepare_process, run_command, save_traceback, terminal_progress
 from wgpuviewer.core.errors import FileError, UserError
 from wgpuviewer.core.images import HEIGHT_CHANNELS, NAN_POLICIES, read_height
 from wgpuviewer.core.io import output_dir, refuse_directory, remove_stale_temps
 from wgpuviewer.core.sidecar import MapRecord, file_sha256, is_recorded, read_record, record_path, write_record
 
 from . import VERSION, generate, resolve_backend
-from .check import DEFAULT_SAMPLE, DEFAULT_SEED, SAMPLED, check_kinds
+from .check import DEFAULT_SAMPLE, DEFAULT_SEED, check_kinds, sampled_kinds
 from .io import INPUT_EXTS, write_result
 from .registry import KINDS, get_kind
 
@@ -143,7 +142,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="compare every value of every kind (the slow CPU references in full: minutes on a 512x512 "
                      "map); default: those kinds at a seeded random sample of values")
     chk.add_argument("--sample", type=int, default=None, metavar="N",
-                     help=f"values compared per sampled kind ({', '.join(SAMPLED)}; default {DEFAULT_SAMPLE})")
+                     help=f"values compared per sampled kind ({', '.join(sampled_kinds())}; default {DEFAULT_SAMPLE})")
     chk.add_argument("--seed", type=int, default=None, metavar="S",
                      help=f"seed of the sample (default {DEFAULT_SEED})")
     _add_input_options(chk)
@@ -160,12 +159,9 @@ def build_parser() -> argparse.ArgumentParser:
     ben.add_argument("--kinds", default=None, help="comma-separated kinds (default all)")
     ben.add_argument("--sizes", default="64,256,1024",
                      help="comma-separated square sizes for the 2D kinds (default %(default)s)")
-    ben.add_argument("--volume-sizes", default="32,64,128",
-                     help="comma-separated square sizes for distance, 16 slices (default %(default)s)")
-    ben.add_argument("--refined-sizes", default="32,64",
-                     help="comma-separated square sizes for distance_refined, 8 slices (default %(default)s)")
-    ben.add_argument("--cone-sizes", default="64,128",
-                     help="comma-separated square sizes for cone, max_ratio 16 (default %(default)s)")
+    for kind in KINDS.values():  # a kind timed at sizes of its own has its flag
+        if kind.bench is not None:
+            ben.add_argument(_flag(kind.bench.attr), default=kind.bench.default, help=kind.bench.help)
     ben.add_argument("--repeat", type=int, default=3,
                      help="timed runs per cell, the best is reported (default %(default)s)")
     return parser
@@ -259,6 +255,61 @@ def up_to_date(out: Path, key: str) -> bool:
         return False
 
 
+def _plan_batch(files: list[Path], kinds: list[str], outdir: Path, rows: list) -> dict[Path, list[tuple[str, Path]]]:
+    """Per input, its (kind, output) jobs; two inputs with one stem would overwrite each other: the second one's
+    job is a FAILED row."""
+    claimed: dict[Path, Path] = {}  # output -> input
+    by_input: dict[Path, list[tuple[str, Path]]] = {}
+    for f in files:
+        for k in kinds:
+            out = outdir / f"{f.stem}.{k}{get_kind(k).extensions[0]}"
+            if out in claimed:
+                rows.append((str(f), k, "FAILED", f"output {out.name} already produced from {claimed[out]}"))
+                continue
+            claimed[out] = f
+            by_input.setdefault(f, []).append((k, out))
+    return by_input
+
+
+def _batch_job(f: Path, digest: str, k: str, out: Path, opts: dict, args, backend: str, height):
+    """One map of a batch: (its table row, the height map read, if it had to be read)."""
+    kind = get_kind(k)
+    key = job_key(digest, k, opts, args, out.suffix.lower())
+    t0 = time.perf_counter()
+    try:
+        if not args.force and up_to_date(out, key):
+            return (str(f), k, "skipped", "up to date"), height
+        for owned in (out, record_path(out)):  # left by a killed earlier run: this job owns both
+            remove_stale_temps(owned)
+        if height is None:
+            height = read_height(f, args.channel, args.nan_policy)
+        result = generate(k, height, backend=backend, **opts)
+        write_result(kind, result, out, args.bits)
+        write_record(out, MapRecord(key=key, kind=k, options=opts, version=VERSION, kernels=kind.source_hash(),
+                                    input=str(f), input_sha256=digest, channel=args.channel,
+                                    output_sha256=file_sha256(out)))
+        return (str(f), k, "ok", f"{out.name} ({time.perf_counter() - t0:.2f} s, {backend})"), height
+    except UserError as exc:
+        return (str(f), k, "FAILED", str(exc)), height
+    except Exception as exc:  # noqa: BLE001 - a bug: report it, keep going with the other jobs
+        saved = save_traceback("maptools", exc)
+        return (str(f), k, "INTERNAL", f"{type(exc).__name__}: {exc} (a bug; traceback "
+                                       f"{f'saved to {saved}' if saved else 'not saved'})"), height
+
+
+def _batch_summary(rows: list, files: list, si: int, sn: int) -> int:
+    """Print the table and the counts; the exit code (3: an internal error, 1: a failed job)."""
+    print_table(rows)
+    failed = sum(r[2] in ("FAILED", "INTERNAL") for r in rows)
+    internal = sum(r[2] == "INTERNAL" for r in rows)
+    done = sum(r[2] == "ok" for r in rows)
+    skipped = sum(r[2] == "skipped" for r in rows)
+    print(f"{done} generated, {skipped} up to date, {failed} failed"
+          + (f" ({internal} internal error(s): please report them)" if internal else "")
+          + (f" (shard {si}/{sn}: {len(files)} input(s))" if sn > 1 else ""))
+    return 3 if internal else 1 if failed else 0
+
+
 def cmd_batch(args) -> int:
     kinds = _parse_kinds(args.kinds)
     kopts = kind_options(kinds, args.set)
@@ -269,60 +320,25 @@ def cmd_batch(args) -> int:
     files, missing = collect_inputs(args.inputs, outdir)
     files = shard(files, si, sn)
     backend = resolve_backend(args.backend) if files else "cpu"
-
     rows: list[tuple[str, str, str, str]] = [(p, "-", "FAILED", msg) for p, msg in missing]
-    claimed: dict[Path, Path] = {}  # output -> input (two inputs with one stem would overwrite each other)
-    plan = []
-    for f in files:
-        for k in kinds:
-            out = outdir / f"{f.stem}.{k}{get_kind(k).extensions[0]}"
-            if out in claimed:
-                rows.append((str(f), k, "FAILED", f"output {out.name} already produced from {claimed[out]}"))
-                continue
-            claimed[out] = f
-            plan.append((f, k, out))
-
-    by_input: dict[Path, list] = {}
-    for f, k, out in plan:
-        by_input.setdefault(f, []).append((k, out))
+    by_input = _plan_batch(files, kinds, outdir, rows)
     try:
         from tqdm import tqdm
-        bar = tqdm(total=len(plan), unit="map", desc="maptools", file=sys.stderr, disable=None)
+        bar = tqdm(total=sum(map(len, by_input.values())), unit="map", desc="maptools", file=sys.stderr, disable=None)
     except ImportError:  # pragma: no cover - tqdm is a dependency
         bar = None
     lock = threading.Lock()
 
     def run_input(f: Path) -> list:
-        res = []
         try:
             digest = hashlib.sha256(f.read_bytes()).hexdigest()
         except OSError as exc:
             return [(str(f), k, "FAILED", f"cannot read: {exc.strerror or exc}") for k, _ in by_input[f]]
-        height = None
+        res, height = [], None
         for k, out in by_input[f]:
-            kind = get_kind(k)
-            key = job_key(digest, k, kopts[k], args, out.suffix.lower())
-            t0 = time.perf_counter()
             try:
-                if not args.force and up_to_date(out, key):
-                    res.append((str(f), k, "skipped", "up to date"))
-                    continue
-                for owned in (out, record_path(out)):  # left by a killed earlier run: this job owns both
-                    remove_stale_temps(owned)
-                if height is None:
-                    height = read_height(f, args.channel, args.nan_policy)
-                result = generate(k, height, backend=backend, **kopts[k])
-                write_result(kind, result, out, args.bits)
-                write_record(out, MapRecord(key=key, kind=k, options=kopts[k], version=VERSION,
-                                            kernels=kind.source_hash(), input=str(f), input_sha256=digest,
-                                            channel=args.channel, output_sha256=file_sha256(out)))
-                res.append((str(f), k, "ok", f"{out.name} ({time.perf_counter() - t0:.2f} s, {backend})"))
-            except UserError as exc:
-                res.append((str(f), k, "FAILED", str(exc)))
-            except Exception as exc:  # noqa: BLE001 - a bug: report it, keep going with the other jobs
-                saved = save_traceback("maptools", exc)
-                res.append((str(f), k, "INTERNAL", f"{type(exc).__name__}: {exc} (a bug; traceback "
-                                                   f"{f'saved to {saved}' if saved else 'not saved'})"))
+                row, height = _batch_job(f, digest, k, out, kopts[k], args, backend, height)
+                res.append(row)
             finally:
                 if bar is not None:
                     with lock:
@@ -340,16 +356,7 @@ def cmd_batch(args) -> int:
             bar.close()
     for r in results:
         rows.extend(r)
-
-    print_table(rows)
-    failed = sum(r[2] in ("FAILED", "INTERNAL") for r in rows)
-    internal = sum(r[2] == "INTERNAL" for r in rows)
-    done = sum(r[2] == "ok" for r in rows)
-    skipped = sum(r[2] == "skipped" for r in rows)
-    print(f"{done} generated, {skipped} up to date, {failed} failed"
-          + (f" ({internal} internal error(s): please report them)" if internal else "")
-          + (f" (shard {si}/{sn}: {len(files)} input(s))" if sn > 1 else ""))
-    return 3 if internal else 1 if failed else 0
+    return _batch_summary(rows, files, si, sn)
 
 
 def print_table(rows) -> None:
@@ -389,7 +396,7 @@ def cmd_check(args) -> int:
     height = read_height(args.input, args.channel, args.nan_policy)
     g = gpu.runner()  # NoAdapterError (exit 2) when there is no GPU to check
     print(f"{args.input}: {height.shape[1]}x{height.shape[0]} on {g.gpu.summary}")
-    sampled = [k for k in kinds if k in SAMPLED]
+    sampled = [k for k in kinds if get_kind(k).sampled is not None]
     if sample is None or not sampled:
         print("comparing every value of every kind")
     else:
@@ -410,58 +417,6 @@ def cmd_check(args) -> int:
     return 1 if bad else 0
 
 
-def _sizes(text: str, flag: str) -> list[int]:
-    try:
-        sizes = [int(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise UserError(f"{flag} {text!r}: expected comma-separated integers, e.g. 64,256") from None
-    if any(n < 1 or n > 8192 for n in sizes):
-        raise UserError(f"{flag} {text!r}: sizes must be in [1, 8192]")
-    return sizes
-
-
-#: kind -> (sizes flag attribute, options used by the benchmark)
-BENCH_SETUP = {"distance": ("volume_sizes", {"slices": 16, "height_scale": 0.05}),
-               "distance_refined": ("refined_sizes", {"slices": 8, "height_scale": 0.25}),
-               "cone": ("cone_sizes", {})}
-
-
-def _best_time(fn, repeat: int) -> float:
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
-
-
-def cmd_bench(args) -> int:
-    """Best-of-N wall time of the CPU and GPU paths (GPU time includes upload and read-back)."""
-    import numpy as np
-
-    from . import gpu
-
-    kinds = _parse_kinds(args.kinds)
-    if args.repeat < 1:
-        raise UserError(f"--repeat {args.repeat}: must be >= 1")
-    g = gpu.runner()
-    print(f"adapter: {g.gpu.summary}")
-    print(f"{'kind':<17} {'size':>11} {'cpu s':>9} {'gpu s':>9} {'cpu/gpu':>8}")
-    rng = np.random.default_rng(0)
-    for k in kinds:
-        attr, opts = BENCH_SETUP.get(k, ("sizes", {}))
-        kind = get_kind(k)
-        opts = kind.resolve(opts)
-        for n in _sizes(getattr(args, attr), _flag(attr)):
-            height = rng.random((n, n)).astype(np.float32)
-            kind.gpu(height, **opts)  # warm-up: pipeline compilation
-            tg = _best_time(functools.partial(kind.gpu, height, **opts), args.repeat)
-            tc = _best_time(functools.partial(kind.cpu, height, **opts), args.repeat)
-            size = f"{n}x{n}" + (f"x{opts['slices']}" if "slices" in opts else "")
-            print(f"{k:<17} {size:>11} {tc:9.4f} {tg:9.4f} {tc / tg:8.2f}")
-    return 0
-
-
 def parse_age(text: str) -> float:
     """'30s', '15m', '12h', '7d', '2w' -> seconds."""
     units = {"s": 1, "m": 60, "h": 3600, "d": 86400, "w": 7 * 86400}
@@ -473,6 +428,12 @@ def parse_age(text: str) -> float:
     if unit not in units or not value >= 0:
         raise UserError(f"--older-than {text!r}: expected an age such as 30m, 12h, 7d or 2w")
     return value * units[unit]
+
+
+def cmd_bench(args) -> int:
+    from .bench import cmd_bench as bench
+
+    return bench(args, _parse_kinds(args.kinds))
 
 
 def cmd_cache(args) -> int:
@@ -499,7 +460,7 @@ def cmd_kinds(args) -> int:
 
 
 def main(argv=None) -> int:
-    """Exit codes (wgpuviewer.core.cli): 0 ok, 1 a batch job or check failed, 2 a user error, 3 an internal error."""
+    """Exit codes (wgpuviewer.core.commands): 0 ok, 1 a batch job or check failed, 2 a user error, 3 an internal error."""
     prepare_process("maptools")  # before any GPU driver loads
     try:
         args = build_parser().parse_args(argv)

@@ -37,7 +37,7 @@ def validate_height(height, what: str = "height map", *, dtype=np.float32, error
     return a
 
 
-def _png_bytes(img: np.ndarray) -> np.ndarray:
+def png_bytes(img: np.ndarray) -> np.ndarray:
     """The encoded PNG (a uint8 array: file objects write it without a copy)."""
     ok, buf = cv2.imencode(".png", img)
     if not ok:
@@ -45,47 +45,9 @@ def _png_bytes(img: np.ndarray) -> np.ndarray:
     return buf
 
 
-def _bits_check(bits: int) -> None:
+def bits_check(bits: int) -> None:
     if bits not in (8, 16):
         raise UserError(f"--bits {bits}: expected 8 or 16")
-
-
-def write_normal(f, n: np.ndarray, ext: str, bits: int = 8) -> None:
-    """.npy: float32 (H, W, 3); .png: RGB = round((n + 1) / 2 * (2^bits - 1))."""
-    if ext == ".npy":
-        np.save(f, np.asarray(n, np.float32))
-        return
-    _bits_check(bits)
-    top = 255 if bits == 8 else 65535
-    n = np.asarray(n)
-    bgr = np.empty(n.shape, np.uint8 if bits == 8 else np.uint16)  # OpenCV writes BGR
-    step = max(1, (1 << 16) // max(n.shape[1], 1))  # float64 in row bands: small temporaries at any size
-    for row in range(0, n.shape[0], step):
-        band = np.asarray(n[row:row + step], np.float64)
-        bgr[row:row + step] = np.clip(np.rint((band + 1.0) * 0.5 * top), 0, top)[:, :, ::-1]
-    f.write(_png_bytes(bgr))
-
-
-def write_complexity(f, c: np.ndarray, ext: str, bits: int = 8) -> None:
-    """.png: grey, 8-bit as computed (16-bit: value * 257, exact); .npy: the uint8 array."""
-    if ext == ".npy":
-        np.save(f, np.asarray(c, np.uint8))
-        return
-    _bits_check(bits)
-    img = np.asarray(c, np.uint8) if bits == 8 else np.asarray(c, np.uint16) * np.uint16(257)
-    f.write(_png_bytes(img))
-
-
-def write_maxmip(f, levels: list, ext: str, bits: int = 8) -> None:
-    """.npz with float32 arrays level0 (the input) ... levelK (1x1)."""
-    np.savez(f, **{f"level{i}": np.asarray(a, np.float32) for i, a in enumerate(levels)})
-
-
-def write_volume(f, vol, ext: str, bits: int = 8) -> None:
-    """.npy: the volume as generated: float32 (Dz, H, W) (distance) or float16 (V, Dz, H, W) (distance_refined);
-    slice k = layer depth t in [k/Dz, (k+1)/Dz]."""
-    a = np.asarray(vol)
-    np.save(f, a if a.dtype == np.float16 else a.astype(np.float32))
 
 
 def write_result(kind, result, path, bits: int = 8) -> Path:
@@ -98,17 +60,16 @@ def write_result(kind, result, path, bits: int = 8) -> Path:
     return path
 
 
-#: The maps a file can stand in for (a scene's ``[materials.X.maps]``): kind -> (dimensions, dtype) of the array it
-#: holds as written (``write_complexity``, ``write_volume``, ``write_cone``).
-READABLE = {"complexity": (2, np.uint8), "distance": (3, np.float32), "distance_refined": (4, np.float16),
-            "cone": (2, np.float32)}
-
-
 def read_map(kind: str, data: bytes, ext: str) -> np.ndarray:
     """The map of ``kind`` in a file's bytes ``data`` (extension ``ext``), as the kind's generator returns it: a
-    complexity PNG's levels (16-bit: value / 257), a cone PNG decoded (``cone.decode_png``: never a wider cone), a
-    .npy array as saved. A UserError says what the bytes hold instead."""
-    dims, dtype = READABLE[kind]
+    PNG through the kind's ``read_png`` (default: 16-bit values / 257), a .npy array as saved. Only kinds with
+    ``readable`` (a scene's ``[materials.X.maps]``) are read. A UserError says what the bytes hold instead."""
+    from .registry import get_kind
+
+    k = get_kind(kind)
+    if k.readable is None:
+        raise UserError(f"{kind} maps are not read from files")
+    dims, dtype = k.readable
     if ext == ".npy":
         try:
             a = np.load(io.BytesIO(data), allow_pickle=False)
@@ -118,28 +79,10 @@ def read_map(kind: str, data: bytes, ext: str) -> np.ndarray:
         a = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
         if a is None or a.ndim != 2 or a.dtype not in (np.uint8, np.uint16):
             raise UserError("not a grey 8- or 16-bit PNG")
-        if kind == "cone":
-            from .cone import decode_png
-
-            a = decode_png(a)
+        if k.read_png is not None:
+            a = k.read_png(a)
         elif a.dtype == np.uint16:
             a = (a // 257).astype(np.uint8)
     if a.ndim != dims or a.dtype != dtype:
         raise UserError(f"holds a {a.dtype} array of shape {a.shape}; a {kind} map is {dims}-D {np.dtype(dtype)}")
     return a
-
-
-def read_maxmip(path) -> list[np.ndarray]:
-    with np.load(path) as z:
-        return [z[f"level{i}"] for i in range(len(z.files))]
-
-
-def write_cone(f, c: np.ndarray, ext: str, bits: int = 8) -> None:
-    """.npy: float32 (H, W) cone ratios; .png: grey floor((2^bits - 1) sqrt(c / 256)) (maptools.cone.decode_png)."""
-    if ext == ".npy":
-        np.save(f, np.asarray(c, np.float32))
-        return
-    _bits_check(bits)
-    from .cone import encode_png
-
-    f.write(_png_bytes(encode_png(c, bits)))

@@ -27,7 +27,7 @@ def sphere_trace(vol: np.ndarray, uv0, view_dir, height_scale: float, *, stop: f
                  max_steps: int = 256, which=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Trace rays entering at ``uv0`` (N, 2) with tangent-space view vectors ``view_dir`` (N, 3), V.z > 0, through
     the distance volume ``vol`` (Dz, H, W), or through volume ``which[n]`` of a (V, Dz, H, W) stack (the refined
-    kind; ``maptools.refined.volume_index`` picks a ray's volume). Returns (t at the stop point, steps taken,
+    kind; ``maptools.kinds.distance_refined.bins.volume_index`` picks a ray's volume). Returns (t at the stop point, steps taken,
     capped flag)."""
     vol = np.asarray(vol, np.float64)
     vol = vol[None] if vol.ndim == 3 else vol

@@ -33,9 +33,9 @@ def small_scene(tmp_path) -> Path:
 
 
 def test_the_package_exports_the_api_without_loading_it():
-    """`import wgpuviewer` (and so every module of it, core.cli first) loads neither wgpu nor OpenCV; the exported
+    """`import wgpuviewer` (and so every module of it, core.commands first) loads neither wgpu nor OpenCV; the exported
     names load the API on first use."""
-    code = ("import sys, wgpuviewer, wgpuviewer.core.cli; heavy = {'wgpu', 'cv2', 'numpy'} & set(sys.modules); "
+    code = ("import sys, wgpuviewer, wgpuviewer.core.commands; heavy = {'wgpu', 'cv2', 'numpy'} & set(sys.modules); "
             "assert not heavy, heavy; assert wgpuviewer.render.__module__ == 'wgpuviewer.api'")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
@@ -118,6 +118,22 @@ def test_a_missing_scene_file_names_it():
         wgpuviewer.render("no_such.toml", size=SIZE)
 
 
+def test_an_argument_error_keeps_argument_value_and_reason_apart_for_the_cli():
+    """The API names its own arguments; the CLI words the same error with the options that set them."""
+    from wgpuviewer.cli_render import RENDER_OPTIONS, option_label
+
+    with pytest.raises(api.ArgumentError) as error:
+        api.camera_for(load_scene(default_scene_path()), {"view_angle": 30, "position": (0, 1, 2)})
+    assert (error.value.argument, error.value.value) == ("view_angle", 30)
+    assert str(error.value) == ("camera.view_angle = 30: camera.position places the camera too; give one of "
+                                "camera.position and camera.view_angle")
+    assert error.value.worded(RENDER_OPTIONS, option_label) == (
+        "--view-angle 30: --camera places the camera too; give one of --camera and --view-angle")
+    with pytest.raises(api.ArgumentError) as error:
+        wgpuviewer.render(technique="nope", size=SIZE)
+    assert error.value.worded(RENDER_OPTIONS, option_label).startswith("--technique = 'nope': unknown technique;")
+
+
 def _angle(a, b) -> float:
     return math.degrees(math.acos(np.clip(np.dot(a, b) / np.linalg.norm(a) / np.linalg.norm(b), -1, 1)))
 
@@ -143,21 +159,15 @@ def test_view_angle_places_the_camera_at_that_angle_from_the_normal(degrees):
 def test_view_angle_follows_a_rotated_subject_and_a_given_target():
     """The subject is the first plane (here after a box); its normal turns with its rotation."""
     scene = parse_scene("""
+objects = [  # the box first: the subject is the first plane
+    { type = "box", material = "m", size = [1.0, 1.0, 1.0], position = [2.0, 0.5, 0.0] },
+    { type = "plane", material = "m", size = [2.0, 2.0], rotation = [90.0, 0.0, 0.0] },
+]
 [camera]
 position = [0.0, 0.5, 3.0]
 target = [0.0, 0.5, 0.0]
 [materials.m]
 albedo = [0.5, 0.5, 0.5]
-[[objects]]
-type = "box"
-material = "m"
-size = [1.0, 1.0, 1.0]
-position = [2.0, 0.5, 0.0]
-[[objects]]
-type = "plane"
-material = "m"
-size = [2.0, 2.0]
-rotation = [90.0, 0.0, 0.0]
 """)
     assert api.subject(scene) == 1
     normal = api.surface_normal(scene)

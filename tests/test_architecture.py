@@ -15,7 +15,6 @@ from wgpuviewer.relief import filters
 from wgpuviewer.viewer.keys import markdown_table
 
 ROOT = Path(__file__).resolve().parents[1]
-SCENE_MODULES = {"wgpuviewer.scene", "wgpuviewer.textures", "wgpuviewer.meshes", "wgpuviewer.camera"}
 
 
 def module_name(path: Path) -> str:
@@ -60,46 +59,88 @@ def graph() -> dict[str, set[str]]:
     return {name: imports_of(name, path, known) for name, path in modules.items()}
 
 
-def room(name: str) -> str:
+#: What each room may import (docs/architecture.md, "The rooms"). A folder room (one technique, one map kind, one
+#: study) is its kind plus its folder name: it never imports another folder of its kind, only the shared modules
+#: around them ("techniques", "maptools", "harness").
+PRODUCT = {"core", "maptools", "map kind", "techniques", "technique", "scene", "relief", "viewer", "api"}
+RULES = {
+    "core": set(),
+    "maptools": {"core", "map kind"},  # the registry finds the kinds; the CLI, cache and check use them
+    "map kind": {"core", "maptools"},
+    "techniques": {"core"},  # the registry: types and discovery (folders are found at run time, never imported)
+    "technique": {"core", "techniques", "maptools", "map kind", "relief"},  # auto's table runs the probe
+    "scene": {"core", "techniques", "scene"},
+    "relief": {"core", "maptools", "map kind", "techniques", "scene"},
+    "viewer": {"core", "maptools", "map kind", "techniques", "scene", "relief"},
+    "api": {"core", "techniques", "scene", "relief", "viewer"},
+    "harness": {"core"},
+    "bench": PRODUCT | {"harness"},
+    "study": PRODUCT | {"harness", "bench"},
+    "lab": PRODUCT | {"harness", "bench", "study"},  # the GPU suite and the docs command
+}
+
+
+def room(name: str) -> tuple[str, str]:
+    """(room, folder) of a module: folder is the technique, map kind or study it belongs to, else ""."""
     parts = name.split(".")
     if parts[0] == "maptools":
-        return "maptools"
-    if len(parts) >= 3 and parts[1] == "lab":
-        if parts[2] in ("bench", "harness"):
-            return parts[2]
-        if len(parts) >= 4 and parts[2] == "studies":
-            return f"studies.{parts[3]}"
-        return "lab"
-    if len(parts) >= 2 and parts[1] in ("core", "relief", "viewer", "techniques"):
-        return parts[1]
-    return name
+        return ("map kind", parts[2]) if len(parts) >= 3 and parts[1] == "kinds" else ("maptools", "")
+    top = parts[1] if len(parts) >= 2 else ""
+    if top == "lab":
+        sub = parts[2] if len(parts) >= 3 else ""
+        if sub == "studies" and len(parts) >= 4:
+            return "study", parts[3]
+        return (sub, "") if sub in ("bench", "harness") else ("lab", "")
+    if top == "techniques":
+        folder = parts[2] if len(parts) >= 3 and (ROOT / "wgpuviewer" / "techniques" / parts[2]).is_dir() else ""
+        return ("technique", folder) if folder else ("techniques", "")
+    if top in ("scene", "textures", "meshes", "camera"):
+        return "scene", ""
+    if top in ("core", "relief", "viewer", "api"):
+        return top, ""
+    return "front", ""  # the package itself, cli, __main__ and the documented re-exports: anything
 
 
 def allowed(src: str, dst: str) -> bool:
-    a, b = room(src), room(dst)
-    if a == b or dst in ("wgpuviewer", "wgpuviewer.lab.studies"):
+    (a, folder_a), (b, folder_b) = room(src), room(dst)
+    if a == "front" or dst in ("wgpuviewer", "wgpuviewer.lab.studies"):
         return True
-    if a == "core":
-        return False
-    if a in ("maptools", "harness"):
-        return b == "core"
-    if src in SCENE_MODULES:
-        return b == "core" or dst == "wgpuviewer.techniques" or dst in SCENE_MODULES
-    base = b == "core" or dst in SCENE_MODULES or b in ("relief", "techniques")
-    if a in ("relief", "techniques"):
-        return b in ("core", "maptools", "relief", "techniques") or dst in SCENE_MODULES
-    if a == "viewer":
-        return base
-    if a == "bench":
-        return base or b in ("maptools", "harness")
-    if a.startswith("studies."):  # a study may measure on the benchmark's views; never another study
-        return base or b in ("maptools", "bench", "harness")
-    return True  # cli, __main__ and the documented re-exports
+    if a == b:
+        return folder_a == folder_b or not folder_b
+    return b in RULES[a]
 
 
 def test_rooms_import_only_what_they_may():
     bad = sorted(f"{src} -> {dst}" for src, dsts in graph().items() for dst in dsts if not allowed(src, dst))
     assert not bad, "imports against the rules of docs/architecture.md:\n" + "\n".join(bad)
+
+
+def test_the_product_never_imports_the_lab():
+    lab = {"lab", "harness", "bench", "study"}
+    bad = sorted(f"{src} -> {dst}" for src, dsts in graph().items() if room(src)[0] in PRODUCT
+                 for dst in dsts if room(dst)[0] in lab)
+    assert not bad, "the product imports the lab:\n" + "\n".join(bad)
+
+
+#: Size limits of the project's Python: a module longer than this does several jobs; a function longer than this
+#: does several steps that want names.
+MAX_MODULE_LINES = 500
+MAX_FUNCTION_LINES = 80
+
+
+def test_modules_and_functions_stay_small():
+    too_long = []
+    for path in project_modules().values():
+        text = path.read_text()
+        if text.count("\n") > MAX_MODULE_LINES:
+            too_long.append(f"{path.relative_to(ROOT)}: {text.count(chr(10))} lines (at most {MAX_MODULE_LINES})")
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                lines = node.end_lineno - node.lineno + 1
+                if lines > MAX_FUNCTION_LINES:
+                    too_long.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name}: {lines} lines "
+                                    f"(at most {MAX_FUNCTION_LINES})")
+    assert not too_long, "\n".join(too_long)
 
 
 def test_no_import_cycles():

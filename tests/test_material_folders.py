@@ -14,7 +14,7 @@ from tests.core.test_images import EXR_UINT, huge_exr
 from wgpuviewer import cli, textures
 from wgpuviewer.core.errors import FileError, InputError, UserError
 from wgpuviewer.scene import default_scene_path, load_scene, with_folder_material
-from wgpuviewer.textures import FOLDER_SLOTS, FolderFiles, file_role, find_material_files
+from wgpuviewer.scene.folders import FOLDER_SLOTS, FolderFiles, file_role, find_material_files
 
 SIZE = 64
 
@@ -72,6 +72,20 @@ def make_folder(root, convention: str):
     return folder
 
 
+#: The default scene's lines naming its bricks material's albedo and height.
+BRICKS_ALBEDO = 'albedo = { builtin = "bricks", size = [512, 512] }'
+BRICKS_HEIGHT = 'height = { builtin = "bricks", size = [512, 512] }'
+
+
+def folder_scene(tmp_path, albedo: str, height: str = BRICKS_HEIGHT) -> tuple[Path, str]:
+    """The default scene as ``tmp_path/s.toml`` (path, text) with its bricks material's albedo line replaced by
+    ``albedo`` (a ``folder = ...`` line) and its height line by ``height``."""
+    text = default_scene_path().read_text().replace(BRICKS_ALBEDO, albedo).replace(BRICKS_HEIGHT, height)
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    return path, text
+
+
 EXPECTED = {
     "ambientcg": ("Rock042_1K-PNG_Color.png", "Rock042_1K-PNG_NormalGL.png", "opengl",
                   "Rock042_1K-PNG_Displacement.png"),
@@ -102,11 +116,7 @@ def test_file_roles_by_name(name, role):
 def test_a_scene_material_from_a_folder_and_keys_that_override_it(tmp_path):
     make_folder(tmp_path, "ambientcg")
     write(tmp_path / "other_height.png", relief()[0][::-1])
-    scene_path = tmp_path / "s.toml"
-    text = (default_scene_path().read_text()
-            .replace('albedo = { builtin = "bricks", size = [512, 512] }', 'folder = "ambientcg"')
-            .replace('height = { builtin = "bricks", size = [512, 512] }', ""))
-    scene_path.write_text(text)
+    scene_path, text = folder_scene(tmp_path, 'folder = "ambientcg"', height="")
     material = load_scene(scene_path).materials["bricks"]
     assert material.albedo.path.name == "Rock042_1K-PNG_Color.png"
     assert material.normal.path.name == "Rock042_1K-PNG_NormalGL.png" and material.normal_y == "opengl"
@@ -128,9 +138,7 @@ def test_ambiguous_and_empty_folders_are_clear_errors(tmp_path):
     (tmp_path / "nothing" / "readme.txt").write_text("hi")
     with pytest.raises(FileError, match="no albedo, normal or height file recognised by name"):
         find_material_files(tmp_path / "nothing")
-    scene_path = tmp_path / "s.toml"
-    scene_path.write_text(default_scene_path().read_text().replace(
-        'albedo = { builtin = "bricks", size = [512, 512] }', 'folder = "ambientcg"'))
+    scene_path, _ = folder_scene(tmp_path, 'folder = "ambientcg"')
     with pytest.raises(UserError) as error:
         load_scene(scene_path)
     assert str(error.value).startswith(f"{scene_path}: materials.bricks.folder = 'ambientcg': 2 candidates")
@@ -189,11 +197,7 @@ def test_keys_next_to_a_folder_win_over_its_files_for_their_slots(tmp_path):
     assert find_material_files(folder, named=FOLDER_SLOTS) == FolderFiles(None, None, "opengl", None)
     with pytest.raises(InputError, match="named \\['depth'\\]: expected slots among albedo, normal, height"):
         find_material_files(folder, named={"depth"})
-    scene_path = tmp_path / "s.toml"
-    text = (default_scene_path().read_text()
-            .replace('albedo = { builtin = "bricks", size = [512, 512] }', 'folder = "generic"')
-            .replace('height = { builtin = "bricks", size = [512, 512] }', 'height = "mine.png"'))
-    scene_path.write_text(text)
+    scene_path, text = folder_scene(tmp_path, 'folder = "generic"', height='height = "mine.png"')
     material = load_scene(scene_path).materials["bricks"]
     assert material.height.path.name == "mine.png" and material.albedo.path.name == "BaseColor.jpg"
     scene_path.write_text(text.replace('height = "mine.png"', 'depth = "mine.png"'))

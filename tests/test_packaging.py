@@ -55,6 +55,7 @@ def test_wheel_lists_every_package_wgsl_file_and_scene(installed):
     expected = {p.relative_to(ROOT).as_posix() for room in ("wgpuviewer", "maptools")
                 for p in (ROOT / room).rglob("__init__.py")}
     expected |= {"wgpuviewer/" + p.relative_to(ROOT).as_posix() for p in (ROOT / "wgsl").rglob("*.wgsl")}
+    expected |= {p.relative_to(ROOT).as_posix() for p in (ROOT / "wgpuviewer" / "techniques").glob("*/*.wgsl")}
     expected |= {"wgpuviewer/" + p.relative_to(ROOT).as_posix() for p in (ROOT / "scenes").glob("*.toml")}
     assert {"wgpuviewer/lab/studies/refined_distance/__init__.py", "wgpuviewer/lab/harness/__init__.py"} <= expected
     assert not expected - names, f"missing from the wheel: {sorted(expected - names)}"

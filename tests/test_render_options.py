@@ -74,20 +74,21 @@ def test_uv_scale_and_height_scale_of_a_material_folder(scene_file, material_fol
     assert np.nanmax(np.abs(deep[covered] - once[covered])) > 0.02  # hits leaving the face: discarded
 
 
+def bad(option: str, *cases) -> list:
+    """(args, fragments) of each (value, how the line shows the option, what it says) given to ``option``."""
+    return [([option, value], [shown, says]) for value, shown, says in cases]
+
+
 @pytest.mark.parametrize("args, fragments", [
-    (["--camera", "1,2"], ["--camera '1,2'", "X,Y,Z"]),
-    (["--camera", "a,b,c"], ["--camera 'a,b,c'", "numbers"]),
-    (["--target", "nan,0,0"], ["--target nan,0,0", "finite"]),
-    (["--fov", "180"], ["--fov 180", "1 (exclusive) to 179 (exclusive)"]),
-    (["--fov", "wide"], ["--fov", "invalid float value"]),
-    (["--view-angle", "-5"], ["--view-angle -5", "0 to 90 (exclusive)"]),
+    *bad("--camera", ("1,2", "--camera '1,2'", "X,Y,Z"), ("a,b,c", "--camera 'a,b,c'", "numbers"),
+         ("0,0,0", "--camera 0,0,0", "at its target"), ("0,0,80", "--camera 0,0,80", "far plane")),
+    *bad("--target", ("nan,0,0", "--target nan,0,0", "finite")),
+    *bad("--fov", ("180", "--fov 180", "1 (exclusive) to 179 (exclusive)"), ("wide", "--fov", "invalid float value")),
+    *bad("--view-angle", ("-5", "--view-angle -5", "0 to 90 (exclusive)")),
     (["--view-angle", "30", "--camera", "0,1,2"], ["--view-angle 30", "give one of --camera and --view-angle"]),
-    (["--camera", "0,0,0"], ["--camera 0,0,0", "at its target"]),
-    (["--camera", "0,0,80"], ["--camera 0,0,80", "far plane"]),
-    (["--height-scale", "1.5"], ["--height-scale 1.5", "0 to 1"]),
-    (["--uv-scale", "0,1"], ["--uv-scale 0", "above 0"]),
-    (["--uv-scale", "1,2,3"], ["--uv-scale '1,2,3'", "U,V"]),
-    (["--uv-scale", "1e9"], ["--uv-scale 1e+09", "texel coordinates"]),
+    *bad("--height-scale", ("1.5", "--height-scale 1.5", "0 to 1")),
+    *bad("--uv-scale", ("0,1", "--uv-scale 0", "above 0"), ("1,2,3", "--uv-scale '1,2,3'", "U,V"),
+         ("1e9", "--uv-scale 1e+09", "texel coordinates")),
 ])
 def test_bad_values_are_one_line_exit_2(args, fragments, tmp_path, capsys):
     out = tmp_path / "x.png"

@@ -9,15 +9,10 @@ import numpy as np
 import pytest
 
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.scene import (
-    DEFAULT_LIGHT,
-    Scene,
-    TextureRef,
-    default_scene_path,
-    load_scene,
-    parse_scene,
-)
+from wgpuviewer.scene import Scene, default_scene_path, load_scene, parse_scene
+from wgpuviewer.scene.model import DEFAULT_LIGHT
 from wgpuviewer.techniques import TECHNIQUES
+from wgpuviewer.textures import TextureRef
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 
@@ -83,10 +78,10 @@ def test_default_scene():
     assert bricks.albedo == bricks.height and bricks.normal is None and not bricks.height_is_depth
     assert bricks.uv_scale == (2.0, 2.0) and 0.04 <= bricks.height_scale <= 0.08
     plane = scene.objects[0]
-    assert (plane.kind, plane.material, plane.size) == ("plane", "bricks", (4.0, 4.0))
-    assert {o.kind for o in scene.objects} == {"plane", "box"}
-    assert {light.kind for light in scene.lights} == {"directional", "point"}
-    direction = next(light.direction for light in scene.lights if light.kind == "directional")
+    assert (plane.type, plane.material, plane.size) == ("plane", "bricks", (4.0, 4.0))
+    assert {o.type for o in scene.objects} == {"plane", "box"}
+    assert {light.type for light in scene.lights} == {"directional", "point"}
+    direction = next(light.direction for light in scene.lights if light.type == "directional")
     assert abs(np.linalg.norm(direction) - 1) < 1e-9
     cam = scene.camera
     assert cam.position[1] > 0.5 and cam.fov == 55.0 and 0 < cam.near < cam.far
@@ -201,7 +196,7 @@ size = [1, 1]
     sun, lamp = scene.lights
     assert sun.direction == (0.0, -1.0, 0.0) and sun.position is None
     assert lamp.position == (1.0, 2.0, 3.0) and lamp.color == (1.0, 0.5, 0.0) and lamp.intensity == 3.0
-    assert [o.kind for o in scene.objects] == ["plane", "box", "quad"]
+    assert [o.type for o in scene.objects] == ["plane", "box", "quad"]
     assert scene.objects[1].size == (1.0, 2.0, 3.0) and scene.objects[1].rotation == (0.0, 45.0, 0.0)
 
 
@@ -544,19 +539,19 @@ def test_curved_builtins_take_their_sizes(tmp_path):
     objects = "".join(f'[[objects]]\ntype = "{kind}"\nmaterial = "rock"\nsize = {size}\n'
                       for kind, size in (("sphere", "[0.5]"), ("cylinder", "[0.5, 2.0]"), ("torus", "[1.0, 0.25]")))
     scene = load(tmp_path, scene_text(objects=objects))
-    assert [(o.kind, o.size) for o in scene.objects] == [
+    assert [(o.type, o.size) for o in scene.objects] == [
         ("sphere", (0.5,)), ("cylinder", (0.5, 2.0)), ("torus", (1.0, 0.25))]
 
 
 def test_showcase_scene():
     """Floor, walls, platforms, a glTF mesh, curved builtins, several lights and the relief settings in use."""
     scene = load_scene(SCENES / "showcase.toml")
-    assert {"plane", "quad", "box", "mesh", "sphere", "torus"} <= {o.kind for o in scene.objects}
+    assert {"plane", "quad", "box", "mesh", "sphere", "torus"} <= {o.type for o in scene.objects}
     assert len(scene.lights) >= 2
     materials = scene.materials.values()
     assert {m.shadows for m in materials} >= {"hard", "soft"}
     assert any(m.depth_offset for m in materials) and any(m.address == "clamp" for m in materials)
-    mesh = next(o for o in scene.objects if o.kind == "mesh")
+    mesh = next(o for o in scene.objects if o.type == "mesh")
     assert mesh.file == SCENES / "showcase_assets" / "pillar.gltf" and mesh.scale == (0.9, 0.9, 0.9)
     assert np.allclose(mesh.size, (0.9 * 0.64, 0.9 * 4.0, 0.9 * 0.64), atol=1e-6)  # the origin-centred box
 

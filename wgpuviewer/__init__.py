@@ -11,7 +11,8 @@ From Python (``api``; docs/usage.md)::
 - ``core/``: errors, GPU, atomic I/O, the image reader, CPU sampling, colour, the WGSL composer (imports nothing
   else of the project);
 - ``scene.py``, ``textures.py``, ``meshes.py``, ``camera.py``: scenes and what they are made of;
-- ``relief/``: techniques, maps, shaders, renderer, probe, float64 reference, accuracy;
+- ``techniques/``: the technique registry and one folder per technique, found without a list;
+- ``relief/``: maps, shaders, renderer, probe, float64 reference, accuracy;
 - ``viewer/``, ``bench/``, ``studies/``: the window, the benchmark, the studies (each imported only by ``cli``,
   the viewer also by ``api``'s ``view``);
 - ``api.py``: ``render``, ``view``, ``CameraSpec`` (exported here), and the camera and relief settings the
@@ -19,8 +20,8 @@ From Python (``api``; docs/usage.md)::
 - ``probe.py``, ``reference.py``, ``accuracy.py``: the documented API, re-exported from ``relief/``;
 - ``gpusuite.py``: ``./dev gpu-suite``, bench and the studies within one time budget, and the README's headline.
 
-The scene modules may import ``core`` and ``relief.techniques`` (scenes name techniques and their parameters).
-This package imports ``api`` on first use of a name it exports, so importing any module of it (``core.cli``,
+The scene modules may import ``core`` and ``techniques`` (scenes name techniques and their parameters).
+This package imports ``api`` on first use of a name it exports, so importing any module of it (``core.commands``,
 before a GPU driver or OpenCV loads) stays cheap.
 """
 

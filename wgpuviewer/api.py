@@ -1,16 +1,19 @@
 """The Python API: ``render`` (a scene drawn offscreen into a numpy array), ``view`` (the interactive viewer as a
-Jupyter widget), and what they share with ``wgpuviewer render``: the camera a render uses (``camera_for``, from a
-``CameraSpec``) and a material's relief settings (``with_relief``).
+Jupyter widget), and ``prepare`` (everything ``render`` does before it draws), through which ``wgpuviewer render``
+draws too: one path for a render. The camera a render uses comes from ``camera_for`` (a ``CameraSpec``), a
+material's relief settings from ``with_relief``.
 
-Arguments are checked before the GPU starts; a bad one is an ``InputError`` (a ValueError) of one line naming it
-(a bad scene file: a ``UserError`` naming the file and key, as in the CLI). The first GPU use is as quiet as the
+Arguments are checked before the GPU starts; a bad one is an ``InputError`` (a ValueError) of one line naming it,
+most an ``ArgumentError`` that keeps the argument, the value and the reason apart so the CLI words it with its
+options (a bad scene file: a ``UserError`` naming the file and key, as in the CLI). The first GPU use is as quiet as the
 CLI's: no driver line about ``XDG_RUNTIME_DIR`` (``core.gpu``); a software adapter is named once on stderr.
 
 The subject of a scene: its first plane (where ``--material`` shows a folder), or its first object when it has
 no plane. ``view_angle``, ``height_scale`` and ``uv_scale`` are about the subject.
 
 Imports: ``core``, the scene modules, ``relief`` and (for ``view``) ``viewer``; never the measuring rooms. The CLI
-imports it (``render``'s options); ``wgpuviewer/__init__`` exports its public names, loading it on first use.
+imports it (``render`` and the offscreen ``view``); ``wgpuviewer/__init__`` exports its public names, loading it on
+first use.
 """
 
 from __future__ import annotations
@@ -18,21 +21,25 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import camera as cam
-from .core.errors import InputError
+from .core.errors import InputError, UserError
 from .scene import (
     SHADOW_MODES,
     Camera,
     Scene,
-    _show,
     default_scene_path,
     load_scene,
     uv_scale_problem,
     with_folder_material,
 )
+from .scene.table import show_value as _show
+
+if TYPE_CHECKING:
+    from .relief.renderer import DrawConfig, OffscreenImage, Renderer
 
 #: The default frame size of ``render``: the CLI's (``cli.DEFAULT_SIZE``; a test holds them equal, the CLI cannot
 #: import this module before its process is prepared).
@@ -43,9 +50,10 @@ DEFAULT_WIDGET_SIZE = (640, 360)
 #: the least recently used one is dropped (its GPU memory released).
 MAX_RENDERERS = 4
 
-#: How messages name each setting: the API's argument names here; the CLI passes its option names.
+#: How messages name each argument (``ArgumentError``).
 API_NAMES = {"position": "camera.position", "target": "camera.target", "fov": "camera.fov",
-             "view_angle": "camera.view_angle", "height_scale": "height_scale", "uv_scale": "uv_scale"}
+             "view_angle": "camera.view_angle", "height_scale": "height_scale", "uv_scale": "uv_scale",
+             "size": "size", "mode": "mode", "technique": "technique", "filter": "filter", "derivatives": "derivatives"}
 
 #: The subject's surface normal in its object's frame (before rotation): a plane's and a box's top face, a quad's
 #: front.
@@ -87,56 +95,68 @@ class CameraSpec:
                          " or a wgpuviewer.CameraSpec")
 
 
-def _label(names: dict, key: str, value) -> str:
-    """``--camera 0,1,2`` for an option of the CLI, ``camera.position = (0, 1, 2)`` for an API argument."""
-    name = names[key]
-    if not name.startswith("--"):
-        return f"{name} = {_show(value)}"
-    if isinstance(value, (tuple, list, np.ndarray)):
-        try:
-            return f"{name} {','.join(f'{float(x):g}' for x in value)}"
-        except (TypeError, ValueError):
-            pass
-    return f"{name} {value:g}" if isinstance(value, float) else f"{name} {value}"
+class ArgumentError(InputError):
+    """A bad value of one argument: ``argument`` (a key of ``API_NAMES``), the ``value`` given and ``reason``, in
+    which ``{key}`` names another argument. The message names them as the API does (``camera.position = (0, 0, 0):
+    the camera is at its target; ...``); a caller that names them otherwise (the CLI: its options) words it again
+    with ``worded``."""
+
+    def __init__(self, argument: str, value, reason: str):
+        self.argument, self.value, self.reason = argument, value, reason
+        super().__init__(self.worded(API_NAMES, lambda name, value: f"{name} = {_show(value)}"))
+
+    def worded(self, names: dict, label) -> str:
+        """The message naming the arguments by ``names``, the bad one as ``label(its name, value)``."""
+        return f"{label(names[self.argument], self.value)}: {self.reason.format_map(names)}"
 
 
-def _number(names: dict, key: str, value, lo: float, hi: float, lo_open: bool, hi_open: bool) -> float:
-    """A real number within lo..hi (open ends as given; hi may be inf): an InputError naming the setting otherwise."""
+def _number(key: str, value, lo: float, hi: float, lo_open: bool, hi_open: bool) -> float:
+    """A real number within lo..hi (open ends as given; hi may be inf): an ArgumentError naming ``key`` otherwise."""
     if math.isinf(hi):
         expected = f"a number above {lo:g}" if lo_open else f"a number of at least {lo:g}"
     else:
         expected = f"a number from {lo:g}{' (exclusive)' if lo_open else ''} to {hi:g}{' (exclusive)' if hi_open else ''}"
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InputError(f"{_label(names, key, value)}: expected {expected}")
+        raise ArgumentError(key, value, f"expected {expected}")
     x = float(value)
     inside = (x > lo if lo_open else x >= lo) and (x < hi if hi_open else x <= hi)
     if not (math.isfinite(x) and inside):
-        raise InputError(f"{_label(names, key, value)}: out of range, expected {expected}")
+        raise ArgumentError(key, value, f"out of range, expected {expected}")
     return x
 
 
-def _point(names: dict, key: str, value) -> np.ndarray:
-    """Three finite numbers as a float64 vector: an InputError naming the setting otherwise."""
+def _point(key: str, value) -> np.ndarray:
+    """Three finite numbers as a float64 vector: an ArgumentError naming ``key`` otherwise."""
     try:
         p = np.asarray(value, np.float64)
     except (TypeError, ValueError):
         p = None
     if p is None or p.shape != (3,) or isinstance(value, (str, bytes)):
-        raise InputError(f"{_label(names, key, value)}: expected a point of 3 numbers x, y, z")
+        raise ArgumentError(key, value, "expected a point of 3 numbers x, y, z")
     if not np.isfinite(p).all():
-        raise InputError(f"{_label(names, key, value)}: expected finite numbers")
+        raise ArgumentError(key, value, "expected finite numbers")
     return p
+
+
+def _entry(key: str, name, get):
+    """The registry entry ``get(name)`` (techniques, filters, derivative sources): an ArgumentError naming ``key``
+    with the registry's reason otherwise."""
+    try:
+        return get(name, key)
+    except UserError as error:
+        reason = str(error).removeprefix(f"{key} = {name!r}: ")
+        raise ArgumentError(key, name, reason.replace("{", "{{").replace("}", "}}")) from None
 
 
 def subject(scene: Scene) -> int:
     """Index of the scene's subject: its first plane (where ``--material`` shows a folder), else its first object."""
-    return next((i for i, o in enumerate(scene.objects) if o.kind == "plane"), 0)
+    return next((i for i, o in enumerate(scene.objects) if o.type == "plane"), 0)
 
 
 def surface_normal(scene: Scene) -> np.ndarray:
     """The world-space unit normal of the subject's surface (``SURFACE_NORMALS``, rotated with its object)."""
     obj = scene.objects[subject(scene)]
-    return cam.normalize(cam.rotation_xyz(obj.rotation)[:3, :3] @ np.asarray(SURFACE_NORMALS[obj.kind]))
+    return cam.normalize(cam.rotation_xyz(obj.rotation)[:3, :3] @ np.asarray(SURFACE_NORMALS[obj.type]))
 
 
 def _perpendicular(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
@@ -144,24 +164,24 @@ def _perpendicular(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
     return v - np.dot(v, axis) * axis
 
 
-def camera_for(scene: Scene, spec: CameraSpec | dict | None = None, names: dict = API_NAMES) -> Camera:
-    """The camera of a render: the scene's, changed by ``spec`` (see ``CameraSpec``), every value checked. The
-    one way ``render``, ``view`` and ``wgpuviewer render --camera/--target/--fov/--view-angle`` build it; messages
-    name the settings by ``names`` (the CLI's options, or the API's argument names)."""
+def camera_for(scene: Scene, spec: CameraSpec | dict | None = None) -> Camera:
+    """The camera of a render: the scene's, changed by ``spec`` (see ``CameraSpec``), every value checked (an
+    ArgumentError). The one way ``render`` (and so ``wgpuviewer render --camera/--target/--fov/--view-angle``)
+    and ``view`` build it."""
     spec = CameraSpec.of(spec)
     base = scene.camera
     if spec.position is not None and spec.view_angle is not None:
-        raise InputError(f"{_label(names, 'view_angle', spec.view_angle)}: {names['position']} places the camera "
-                         f"too; give one of {names['position']} and {names['view_angle']}")
-    target = _point(names, "target", spec.target) if spec.target is not None else np.asarray(base.target)
-    fov = _number(names, "fov", spec.fov, 1, 179, True, True) if spec.fov is not None else base.fov
+        raise ArgumentError("view_angle", spec.view_angle,
+                            "{position} places the camera too; give one of {position} and {view_angle}")
+    target = _point("target", spec.target) if spec.target is not None else np.asarray(base.target)
+    fov = _number("fov", spec.fov, 1, 179, True, True) if spec.fov is not None else base.fov
     if spec.view_angle is not None:
-        angle = math.radians(_number(names, "view_angle", spec.view_angle, 0, 90, False, True))
-        kind = scene.objects[subject(scene)].kind
-        if kind not in SURFACE_NORMALS:  # a curved or mesh subject has no one normal to measure the angle from
-            raise InputError(f"{_label(names, 'view_angle', spec.view_angle)}: the scene's subject (its first "
-                             f"plane, else its first object) is a {kind}, which has no single surface normal; "
-                             f"expected a subject of type {', '.join(SURFACE_NORMALS)}, or give {names['position']}")
+        angle = math.radians(_number("view_angle", spec.view_angle, 0, 90, False, True))
+        object_type = scene.objects[subject(scene)].type
+        if object_type not in SURFACE_NORMALS:  # a curved or mesh subject has no one normal to measure the angle from
+            raise ArgumentError("view_angle", spec.view_angle, f"the scene's subject (its first plane, else its "
+                                f"first object) is a {object_type}, which has no single surface normal; expected a subject "
+                                f"of type {', '.join(SURFACE_NORMALS)}, or give {{position}}")
         normal = surface_normal(scene)
         seen_from = np.asarray(base.position) - target
         distance = float(np.linalg.norm(seen_from))
@@ -171,18 +191,18 @@ def camera_for(scene: Scene, spec: CameraSpec | dict | None = None, names: dict 
         position = target + distance * (math.cos(angle) * normal + math.sin(angle) * cam.normalize(side))
         key = "view_angle"
     elif spec.position is not None:
-        position, key = _point(names, "position", spec.position), "position"
+        position, key = _point("position", spec.position), "position"
     else:
         position, key = np.asarray(base.position), "target" if spec.target is not None else None
     view = target - position
     distance = float(np.linalg.norm(view))
     if key is not None:  # the scene checked its own camera
         if distance < 1e-9:
-            raise InputError(f"{_label(names, key, getattr(spec, key))}: the camera is at its target; expected "
-                             f"{names['position']} and {names['target']} apart")
+            raise ArgumentError(key, getattr(spec, key),
+                                "the camera is at its target; expected {position} and {target} apart")
         if distance >= base.far:
-            raise InputError(f"{_label(names, key, getattr(spec, key))}: the target is {distance:.4g} from the "
-                             f"camera, beyond its far plane at {base.far:g} (the scene's camera.far); move them closer")
+            raise ArgumentError(key, getattr(spec, key), f"the target is {distance:.4g} from the camera, beyond "
+                                f"its far plane at {base.far:g} (the scene's camera.far); move them closer")
     forward = view / distance
     up = np.asarray(base.up)
     if np.linalg.norm(np.cross(up, forward)) < 1e-6:  # looking along up: the scene camera's view direction is up
@@ -191,25 +211,25 @@ def camera_for(scene: Scene, spec: CameraSpec | dict | None = None, names: dict 
                    up=tuple(float(x) for x in up), fov=fov)
 
 
-def with_relief(scene: Scene, height_scale=None, uv_scale=None, names: dict = API_NAMES) -> Scene:
+def with_relief(scene: Scene, height_scale=None, uv_scale=None) -> Scene:
     """``scene`` with the subject's material given a relief depth (``height_scale``, UV units, 0 to 1) and a
     tiling (``uv_scale``: one number for both directions, or (u, v), each above 0); None keeps the material's.
     Every object of that material shows the change. Checked as a scene's values are (the texel-coordinate limit
-    included); messages name the settings by ``names``."""
+    included): an ArgumentError naming the setting."""
     if height_scale is None and uv_scale is None:
         return scene
     name = scene.objects[subject(scene)].material
     material = scene.materials[name]
     if height_scale is not None:
-        material = replace(material, height_scale=_number(names, "height_scale", height_scale, 0, 1, False, False))
+        material = replace(material, height_scale=_number("height_scale", height_scale, 0, 1, False, False))
     if uv_scale is not None:
         pair = (uv_scale, uv_scale) if np.ndim(uv_scale) == 0 else uv_scale
         if isinstance(pair, (str, bytes)) or np.ndim(pair) != 1 or len(pair) != 2:
-            raise InputError(f"{_label(names, 'uv_scale', uv_scale)}: expected a number or two (u, v)")
-        tiling = tuple(_number(names, "uv_scale", x, 0, math.inf, True, True) for x in pair)
+            raise ArgumentError("uv_scale", uv_scale, "expected a number or two (u, v)")
+        tiling = tuple(_number("uv_scale", x, 0, math.inf, True, True) for x in pair)
         problem = uv_scale_problem(material, tiling)
         if problem:
-            raise InputError(f"{_label(names, 'uv_scale', uv_scale)}: {problem}")
+            raise ArgumentError("uv_scale", uv_scale, problem.replace("{", "{{").replace("}", "}}"))
         material = replace(material, uv_scale=tiling)
     return replace(scene, materials={**scene.materials, name: material})
 
@@ -229,11 +249,11 @@ def scene_of(scene=None, material=None, height_scale=None, uv_scale=None) -> Sce
     return with_relief(scene, height_scale, uv_scale)
 
 
-def _size(size, name: str = "size") -> tuple[int, int]:
+def _size(size) -> tuple[int, int]:
     valid = (isinstance(size, (tuple, list)) and len(size) == 2
              and all(isinstance(s, (int, np.integer)) and not isinstance(s, bool) and 1 <= s <= 16384 for s in size))
     if not valid:
-        raise InputError(f"{name} = {_show(size)}: expected (width, height), integers 1 to 16384")
+        raise ArgumentError("size", size, "expected (width, height), integers 1 to 16384")
     return int(size[0]), int(size[1])
 
 
@@ -255,6 +275,55 @@ def renderer_for(scene: Scene, gpu):
     return renderer
 
 
+@dataclass(frozen=True)
+class Prepared:
+    """A render made ready (``prepare``): the scene's renderer with the maps the technique needs built, the draw
+    configuration, the camera and the frame size."""
+
+    renderer: Renderer
+    draw: DrawConfig
+    camera: Camera
+    size: tuple[int, int]
+
+    def image(self, mode: str = "color", camera: Camera | None = None) -> OffscreenImage:
+        """The frame drawn offscreen (``Renderer.render``; ``mode`` "albedo" draws the unlit albedo), from
+        ``camera`` (None: the prepared one). A frame the adapter cannot allocate is a FrameError naming ``size``."""
+        return self.renderer.render(self.draw, self.size, camera or self.camera, mode, size_name="size")
+
+
+def prepare(scene=None, technique=None, size: tuple[int, int] = DEFAULT_SIZE, camera=None, *, material=None,
+            height_scale=None, uv_scale=None, filter: str | None = None, derivatives: str | None = None,
+            shadows: str | None = None, backend: str | None = None, keep: bool = True) -> Prepared:
+    """Everything ``render`` does before it draws (the arguments are ``render``'s; ``technique`` may also be a
+    ``Technique``): every argument checked before the GPU starts, the renderer made (``keep``: the scene's kept
+    renderer, ``renderer_for``; False: one of its own, dropped with the result), the maps the technique needs built
+    (a progress bar on a terminal). ``wgpuviewer render`` and the viewer's offscreen fallback draw through it."""
+    from .core.commands import terminal_progress
+    from .core.gpu import get_gpu
+    from .relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, get_derivatives, get_filter
+    from .relief.renderer import Renderer, check_frame_size
+    from .techniques import Technique, get_technique
+
+    size = _size(size)
+    spec = CameraSpec.of(camera)
+    if shadows is not None and shadows not in SHADOW_MODES:
+        raise InputError(f"shadows = {_show(shadows)}: expected one of {', '.join(SHADOW_MODES)}, or None")
+    scene = scene_of(scene, material, height_scale, uv_scale)
+    view = camera_for(scene, spec)
+    technique = technique or scene.technique
+    if not isinstance(technique, Technique):
+        technique = _entry("technique", technique, get_technique)
+    filtering = {"filter": _entry("filter", filter or DEFAULT_FILTER, get_filter).name,
+                 "derivatives": _entry("derivatives", derivatives or DEFAULT_DERIVATIVES, get_derivatives).name,
+                 "shadows": shadows}
+    gpu = get_gpu(backend)
+    check_frame_size(gpu, size, "size")
+    renderer = renderer_for(scene, gpu) if keep else Renderer(scene, gpu)
+    with terminal_progress(f"maps for {technique.name}") as progress:
+        renderer.prepare(technique, progress)
+    return Prepared(renderer, renderer.config(technique, **filtering), view, size)
+
+
 def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEFAULT_SIZE, camera=None,
            mode: str = "color", *, alpha: bool = False, material=None, height_scale=None, uv_scale=None,
            filter: str | None = None, derivatives: str | None = None, shadows: str | None = None,
@@ -270,7 +339,7 @@ def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEF
     ``height_scale``, ``uv_scale``: the subject's relief depth and tiling; ``filter``, ``derivatives``: the texture
     filter and its derivative source (``wgpuviewer filters``); ``shadows``: "off", "hard" or "soft" for every
     material (``render --shadows``; None: each material's own ``shadows``); ``backend``: auto, vulkan, metal, dx12
-    or gl.
+    or gl. A bad argument is an ``ArgumentError`` (an InputError) naming it.
 
     The maps a technique needs are built on first use (and cached on disk); the renderer of a scene is kept, so
     repeated renders of it (other techniques, cameras, modes) cost only the drawing.
@@ -280,32 +349,14 @@ def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEF
     >>> image.shape
     (180, 320, 3)
     """
-    from .core.cli import terminal_progress
-    from .core.gpu import get_gpu
-    from .relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, get_derivatives, get_filter
     from .relief.output import OUTPUT_MODES, mode_data
-    from .relief.renderer import check_frame_size
-    from .relief.techniques import get_technique
 
     size = _size(size)
     if mode not in OUTPUT_MODES:
-        raise InputError(f"mode = {_show(mode)}: expected one of {', '.join(OUTPUT_MODES)}")
-    spec = CameraSpec.of(camera)
-    if shadows is not None and shadows not in SHADOW_MODES:
-        raise InputError(f"shadows = {_show(shadows)}: expected one of {', '.join(SHADOW_MODES)}, or None")
-    filtering = {"filter": get_filter(filter or DEFAULT_FILTER, "filter").name,
-                 "derivatives": get_derivatives(derivatives or DEFAULT_DERIVATIVES, "derivatives").name,
-                 "shadows": shadows}
-    scene = scene_of(scene, material, height_scale, uv_scale)
-    name = get_technique(technique or scene.technique, "technique").name
-    view = camera_for(scene, spec)
-    gpu = get_gpu(backend)
-    check_frame_size(gpu, size, "size")
-    renderer = renderer_for(scene, gpu)
-    with terminal_progress(f"maps for {name}") as progress:
-        renderer.prepare(name, progress)
-    image = renderer.render(renderer.config(name, **filtering), size, view, mode=mode, size_name="size")
-    return mode_data(image, mode, alpha)
+        raise ArgumentError("mode", mode, f"expected one of {', '.join(OUTPUT_MODES)}")
+    prepared = prepare(scene, technique, size, camera, material=material, height_scale=height_scale,
+                       uv_scale=uv_scale, filter=filter, derivatives=derivatives, shadows=shadows, backend=backend)
+    return mode_data(prepared.image(mode), mode, alpha)
 
 
 def view(scene=None, technique: str | None = None, size: tuple[int, int] = DEFAULT_WIDGET_SIZE, camera=None, *,
@@ -316,13 +367,13 @@ def view(scene=None, technique: str | None = None, size: tuple[int, int] = DEFAU
     are ``render``'s; ``size`` is the widget's in logical pixels; ``camera`` is where the viewer's cameras start
     (R resets to it). Returns the widget (``snapshot()`` gives its last frame as a picture)."""
     from .relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER
-    from .relief.techniques import get_technique
+    from .techniques import get_technique
     from .viewer.app import Viewer
 
     size = _size(size)
     spec = CameraSpec.of(camera)
     scene = scene_of(scene, material, height_scale, uv_scale)
-    name = get_technique(technique or scene.technique, "technique").name
+    name = _entry("technique", technique or scene.technique, get_technique).name
     scene = replace(scene, camera=camera_for(scene, spec))
     viewer = Viewer(scene, name, backend, gui="jupyter", size=size, filter=filter or DEFAULT_FILTER,
                     derivatives=derivatives or DEFAULT_DERIVATIVES, shadows=shadows)
@@ -330,4 +381,5 @@ def view(scene=None, technique: str | None = None, size: tuple[int, int] = DEFAU
     return viewer.window.canvas
 
 
-__all__ = ["DEFAULT_SIZE", "CameraSpec", "camera_for", "render", "scene_of", "subject", "view", "with_relief"]
+__all__ = ["DEFAULT_SIZE", "ArgumentError", "CameraSpec", "Prepared", "camera_for", "prepare", "render", "scene_of", "subject",
+           "view", "with_relief"]

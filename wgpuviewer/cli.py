@@ -9,10 +9,9 @@ import os
 import sys
 from pathlib import Path
 
-from wgpuviewer.core.cli import (
+from wgpuviewer.core.commands import (
     OneLineParser,
     add_backend_option,
-    comma_numbers,
     command_line,
     parse_size,
     prepare_process,
@@ -21,6 +20,8 @@ from wgpuviewer.core.cli import (
 )
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import refuse_directory
+
+from .cli_render import api_errors, prepare_render, render_orbit, save_render
 
 DEFAULT_SIZE = (1280, 720)
 #: What `render`'s --height-scale, --uv-scale and --view-angle are about (wgpuviewer.api.subject).
@@ -48,7 +49,7 @@ def pick_technique(scene, name: str | None) -> str:
 
 
 def pick_filtering(args) -> dict:
-    """DrawConfig's filter and derivatives from ``--filter`` / ``--derivatives`` (checked against the registry),
+    """The viewer's filter and derivatives from ``--filter`` / ``--derivatives`` (checked against the registry),
     and its self-shadowing override from ``--shadows`` (None: each material's own)."""
     from wgpuviewer.relief.filters import get_derivatives, get_filter
 
@@ -60,33 +61,6 @@ def has_display() -> bool:
     if sys.platform.startswith("linux"):
         return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
     return True
-
-
-def prepared_renderer(scene, technique: str, size: tuple[int, int], backend: str | None):
-    """A Renderer of ``scene`` with the maps ``technique`` needs built (a progress bar); a frame of ``size`` too large
-    for the adapter is refused (naming ``--size``) before any map is built."""
-    from wgpuviewer.core.gpu import get_gpu
-    from wgpuviewer.relief.renderer import Renderer, check_frame_size
-
-    gpu = get_gpu(backend)
-    check_frame_size(gpu, size, "--size")
-    renderer = Renderer(scene, gpu)
-    with terminal_progress(f"maps for {technique}") as progress:
-        renderer.prepare(technique, progress)
-    return renderer
-
-
-def render_to(out: Path, scene, technique: str, size: tuple[int, int], mode: str, backend: str | None,
-              filtering: dict, camera=None, alpha: bool = False) -> None:
-    """Render ``scene`` offscreen into ``out`` (.png or .npy), the maps it needs built first with a progress bar;
-    ``filtering``: the texture filter and derivative source (``pick_filtering``); ``camera``: the scene's when None
-    (``render_view``); ``alpha``: transparent where nothing was drawn (``relief.output``). A frame too large for the
-    adapter is refused (naming ``--size``) before any map is built."""
-    from wgpuviewer.relief.output import save_output
-
-    renderer = prepared_renderer(scene, technique, size, backend)
-    image = renderer.render(renderer.config(technique, **filtering), size, camera, mode=mode, size_name="--size")
-    save_output(out, image, mode, alpha)
 
 
 def cmd_render(args) -> int:
@@ -105,58 +79,15 @@ def cmd_render(args) -> int:
     elif out.suffix.lower() not in OUTPUT_SUFFIXES:
         raise UserError(f"-o {out}: unknown output type {out.suffix!r}; use .png (image) or .npy (raw float32 data), "
                         "or .gif or .mp4 with --orbit N")
-    scene, camera = render_view(args, scene_from_args(args))
-    technique = pick_technique(scene, args.technique)
-    if args.orbit is not None:
-        render_orbit(out, scene, technique, size, args.mode, args.backend, pick_filtering(args), camera, args.orbit)
-    else:
-        render_to(out, scene, technique, size, args.mode, args.backend, pick_filtering(args), camera, args.alpha)
+    scene = scene_from_args(args)
+    with api_errors():
+        prepared = prepare_render(args, scene, size)
+        if args.orbit is not None:
+            render_orbit(out, prepared, args.mode, args.orbit)
+        else:
+            save_render(out, prepared, args.mode, args.alpha)
     print(out)
     return 0
-
-
-def render_orbit(out: Path, scene, technique: str, size: tuple[int, int], mode: str, backend: str | None,
-                 filtering: dict, camera, frames: int) -> None:
-    """A turntable (``relief.turntable``): ``frames`` renders of one turn of ``camera`` about its target, written to
-    ``out`` (.gif or .mp4, checked by ``check_turntable`` first)."""
-    from tqdm import tqdm
-
-    from wgpuviewer.relief.turntable import turntable_pictures, write_turntable
-
-    renderer = prepared_renderer(scene, technique, size, backend)
-    with tqdm(total=frames, desc="turntable", unit="frame", file=sys.stderr, disable=None, leave=False) as bar:
-        pictures = turntable_pictures(renderer, renderer.config(technique, **filtering), camera or scene.camera,
-                                      size, frames, mode, progress=lambda done, total: bar.update(1))
-        write_turntable(out, pictures, size)
-
-
-#: The names `render`'s messages give the settings it shares with the Python API (wgpuviewer.api).
-RENDER_OPTIONS = {"position": "--camera", "target": "--target", "fov": "--fov", "view_angle": "--view-angle",
-                  "height_scale": "--height-scale", "uv_scale": "--uv-scale"}
-
-
-def render_view(args, scene):
-    """The scene with ``--height-scale``/``--uv-scale`` applied and the camera of ``--camera``, ``--target``,
-    ``--fov`` and ``--view-angle``: built and checked by the Python API's functions (``api.with_relief``,
-    ``api.camera_for``), so a render from the command line and one from Python agree."""
-    from wgpuviewer.api import CameraSpec, camera_for, with_relief
-
-    tiling = comma_numbers(args.uv_scale, "--uv-scale", "2 or 2,1")
-    if tiling is not None and len(tiling) not in (1, 2):
-        raise UserError(f"--uv-scale {args.uv_scale!r}: expected one number (both directions) or U,V, e.g. 2,1")
-    scene = with_relief(scene, args.height_scale, tiling if tiling is None or len(tiling) == 2 else tiling[0],
-                        RENDER_OPTIONS)
-    spec = CameraSpec(position=point_option(args.camera, "--camera"), target=point_option(args.target, "--target"),
-                      fov=args.fov, view_angle=args.view_angle)
-    return scene, camera_for(scene, spec, RENDER_OPTIONS)
-
-
-def point_option(text: str | None, option: str) -> tuple[float, float, float] | None:
-    """``X,Y,Z`` as three numbers (None when the option was not given)."""
-    numbers = comma_numbers(text, option, "0,1.4,3.2")
-    if numbers is not None and len(numbers) != 3:
-        raise UserError(f"{option} {text!r}: expected three numbers X,Y,Z, e.g. 0,1.4,3.2")
-    return None if numbers is None else tuple(numbers)
 
 
 def scene_from_args(args, fallback: str | None = None):
@@ -209,8 +140,11 @@ def cmd_view(args) -> int:
 
 
 def view_offscreen(args, scene, technique: str, filtering: dict, size: tuple[int, int]) -> int:
-    """``view`` without a display: the scene the window would show, rendered offscreen at the window's size into
-    ``--screenshot`` (without the HUD), or into out/SCENE_TECHNIQUE.png when no screenshot was asked for."""
+    """``view`` without a display: the scene the window would show, rendered offscreen (``api.prepare``) at the
+    window's size into ``--screenshot`` (without the HUD), or into out/SCENE_TECHNIQUE.png when no screenshot was
+    asked for."""
+    from wgpuviewer.api import prepare
+
     if args.screenshot:
         out = Path(args.screenshot)
         print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): writing {out} as an offscreen render of the scene "
@@ -218,7 +152,8 @@ def view_offscreen(args, scene, technique: str, filtering: dict, size: tuple[int
     else:
         out = Path("out") / f"{Path(scene.path).stem if scene.path else 'scene'}_{technique}.png"
         print(f"no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the scene to {out} instead")
-    render_to(out, scene, technique, size, "color", args.backend, filtering)
+    with api_errors():
+        save_render(out, prepare(scene, technique, size, backend=args.backend, keep=False, **filtering), "color")
     print(out)
     return 0
 
@@ -370,17 +305,8 @@ def measurement_commands() -> list:
     return [BENCH, *discover()]
 
 
-def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
-    """The parser and the names of its commands."""
-    from wgpuviewer.lab.harness.study import register
-    from wgpuviewer.relief.output import MODE_DESCRIPTIONS, OUTPUT_MODES
-
-    parser = OneLineParser(
-        prog="wgpuviewer", description="Relief-mapping techniques on WebGPU: viewer, offscreen renderer, probe."
-    )
-    parser.add_argument("--version", action="version", version=f"%(prog)s {installed_version()}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-
+def add_view_command(sub) -> None:
+    """``view``'s parser."""
     view = sub.add_parser("view", help="open the interactive viewer (renders a PNG when there is no display)")
     view.add_argument("scene", nargs="?", help="scene TOML (default: the built-in default scene)")
     view.add_argument("--technique", help="technique to start with (default: the scene's)")
@@ -398,6 +324,11 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
     view.add_argument("--material", metavar="DIR", help=MATERIAL_HELP)
     add_filter_options(view)
     view.set_defaults(func=cmd_view)
+
+
+def add_render_command(sub) -> None:
+    """``render``'s parser."""
+    from wgpuviewer.relief.output import MODE_DESCRIPTIONS, OUTPUT_MODES
 
     render = sub.add_parser("render", help="render a scene offscreen to PNG or .npy")
     render.add_argument("scene", nargs="?", help="scene TOML (default: the built-in default scene)")
@@ -433,6 +364,21 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
     add_filter_options(render)
     render.set_defaults(func=cmd_render)
 
+
+def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
+    """The parser and the names of its commands."""
+    from wgpuviewer.lab.docs import register as register_docs
+    from wgpuviewer.lab.harness.study import register
+
+    parser = OneLineParser(
+        prog="wgpuviewer", description="Relief-mapping techniques on WebGPU: viewer, offscreen renderer, probe."
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {installed_version()}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    add_view_command(sub)
+    add_render_command(sub)
+
     warm_ = sub.add_parser("warm", help="build every map a scene's techniques need into the map cache, now")
     warm_.add_argument("scene", nargs="?", metavar="SCENE|DIR",
                        help="scene TOML, or a material folder shown on the default scene (default: the default scene)")
@@ -462,6 +408,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
 
     for study in measurement_commands():
         register(sub, study)
+    register_docs(sub)  # the lab's `wgpuviewer docs`: the generated blocks of README.md and docs/*.md
 
     info = sub.add_parser("info", help="list GPU adapters, the chosen one and its relevant features")
     add_backend_option(info)
@@ -480,7 +427,7 @@ def installed_version() -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Exit codes (wgpuviewer.core.cli): 0 ok, 1 a check failed, 2 a user error, 3 an internal error."""
+    """Exit codes (wgpuviewer.core.commands): 0 ok, 1 a check failed, 2 a user error, 3 an internal error."""
     prepare_process("wgpuviewer")  # before any GPU driver loads
     given = list(sys.argv[1:] if argv is None else argv)
 

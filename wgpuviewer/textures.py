@@ -9,9 +9,7 @@ Loaded arrays are cached (several techniques share them) and returned read-only.
 from __future__ import annotations
 
 import contextlib
-import re
-import stat
-from collections.abc import Callable, Collection
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -19,9 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from wgpuviewer.core.color import srgb_to_linear
-from wgpuviewer.core.errors import FileError, InputError, UserError
-from wgpuviewer.core.images import MAX_SIDE, link_problem, read_height, read_image
-from wgpuviewer.core.sidecar import is_recorded
+from wgpuviewer.core.errors import FileError, UserError
+from wgpuviewer.core.images import MAX_SIDE, read_height, read_image
 
 
 @dataclass(frozen=True)
@@ -292,118 +289,6 @@ def load_normal_map(ref: TextureRef, normal_y: str = "opengl") -> np.ndarray:
     if zero:
         raise ref.error(f"{zero} zero-length normals (texels at 0.5 grey); expected a normal map")
     return _read_only((n / length).astype(np.float32))
-
-
-# ----------------------------------------------------------------------------------------------
-# Material folders, as technical artists download them: each file's role is read from its name.
-
-#: The slots a material folder fills.
-FOLDER_SLOTS = ("albedo", "normal", "height")
-#: Files a material folder may contribute.
-FOLDER_EXTS = (".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".npy")
-#: Name tokens per slot (case-insensitive; names split at non-letters and camel case): ambientCG
-#: (NAME_Color, NAME_NormalGL / NAME_NormalDX, NAME_Displacement), Poly Haven (name_diff_1k, name_nor_gl_1k /
-#: name_nor_dx_1k, name_disp_1k) and the generic albedo|basecolor|diffuse, normal, height|displacement|disp|bump.
-NORMAL_TOKENS = frozenset({"normal", "normals", "normalgl", "normaldx", "nor", "nrm", "norm"})
-HEIGHT_TOKENS = frozenset({"height", "heightmap", "displacement", "disp", "bump"})
-ALBEDO_TOKENS = frozenset({"albedo", "basecolor", "basecolour", "diffuse", "diff", "color", "colour", "col"})
-DIRECTX_TOKENS = frozenset({"dx", "directx", "normaldx"})
-
-
-def name_tokens(name: str) -> set[str]:
-    """Lower-case words of a file stem: split at non-letters/digits and at camel case (NormalGL: normal, gl)."""
-    chunks = [c for c in re.split(r"[^A-Za-z0-9]+", name) if c]
-    words = {c.lower() for c in chunks}
-    for chunk in chunks:
-        words.update(w.lower() for w in re.findall(r"[A-Z]+(?![a-z])|[A-Z]?[a-z]+|\d+[A-Za-z]*", chunk))
-    return words
-
-
-def file_role(path: Path) -> tuple[str, str] | None:
-    """(slot, normal convention) a material-folder file plays by its name, or None: ("normal", "opengl" |
-    "directx"), ("height", ""), ("albedo", ""). Roughness, AO, previews and the like play none."""
-    if path.suffix.lower() not in FOLDER_EXTS:
-        return None
-    words = name_tokens(path.stem)
-    if words & NORMAL_TOKENS:
-        return "normal", "directx" if words & DIRECTX_TOKENS else "opengl"
-    if words & HEIGHT_TOKENS:
-        return "height", ""
-    if words & ALBEDO_TOKENS:
-        return "albedo", ""
-    return None
-
-
-@dataclass(frozen=True)
-class FolderFiles:
-    """What a material folder holds per slot (None where it has nothing), and its normal map's convention."""
-
-    albedo: Path | None
-    normal: Path | None
-    normal_y: str
-    height: Path | None
-
-
-def _entry_problem(path: Path) -> str | None:
-    """Why a folder entry named like a texture is no file to read (a broken link, a link loop, a folder), or None."""
-    problem = link_problem(path)
-    if problem is not None:
-        return problem
-    try:
-        mode = path.stat().st_mode
-    except OSError as e:
-        return f"cannot read ({e.strerror or e})"
-    if stat.S_ISDIR(mode):
-        return "a folder, not an image file; rename or remove it"
-    if not stat.S_ISREG(mode):
-        return "not a regular file; replace it with an image file"
-    return None
-
-
-def find_material_files(folder: Path, named: Collection[str] = ()) -> FolderFiles:
-    """The material folder's files (``file_role``) for each of FOLDER_SLOTS not in ``named``; the slots in
-    ``named`` are those the scene gives next to ``folder`` (they win: the folder is not searched for them, and
-    their slots are None here). Where a folder has both an OpenGL and a DirectX normal map (ambientCG ships both),
-    the OpenGL one is taken; two candidates for one slot are an error listing them; an entry named for a slot that
-    is no readable file (a broken link, a link loop, a folder) is an error naming it, never skipped. Maps
-    ``maptools batch`` wrote into the folder (a file with its record ``NAME.json``, ``core.sidecar``) are left out:
-    ``X_Displacement.normal.png`` is derived from the height, not the set's normal map. Raises FileError (reason:
-    what was found and the fix)."""
-    unknown = set(named) - set(FOLDER_SLOTS)
-    if unknown:
-        raise InputError(f"named {sorted(unknown)}: expected slots among {', '.join(FOLDER_SLOTS)}")
-    if not folder.is_dir():
-        raise FileError(folder, "not a folder; expected a material folder (e.g. an ambientCG or Poly Haven download)")
-    searched = [slot for slot in FOLDER_SLOTS if slot not in named]
-    found: dict[str, list[tuple[Path, str]]] = {slot: [] for slot in FOLDER_SLOTS}
-    unusable = []
-    for path in sorted(folder.iterdir()):
-        role = file_role(path)
-        if role is None or role[0] not in searched or is_recorded(path):  # maptools' maps are none of the textures
-            continue
-        problem = _entry_problem(path)
-        if problem is None:
-            found[role[0]].append((path, role[1]))
-        else:
-            unusable.append(f"{path.name}: {problem}")
-    if unusable:
-        raise FileError(folder, "; ".join(unusable))
-    gl = [c for c in found["normal"] if c[1] == "opengl"]
-    normals = gl or found["normal"]  # OpenGL first: the shader's convention, and ambientCG's NormalGL
-    for slot, candidates in (("albedo", found["albedo"]), ("normal", normals), ("height", found["height"])):
-        if len(candidates) > 1:
-            names = ", ".join(p.name for p, _ in candidates)
-            raise FileError(folder, f"{len(candidates)} candidates for the {slot}: {names}; keep one in the folder "
-                                    f"or name the file in the scene ({slot} = \"...\")")
-    if searched and not any(found.values()):
-        slots = " or ".join(filter(None, (", ".join(searched[:-1]), searched[-1])))
-        raise FileError(folder, f"no {slots} file recognised by name (expected e.g. "
-                                "NAME_Color/NAME_NormalGL/NAME_Displacement, name_diff_1k/name_nor_gl_1k/name_disp_1k, "
-                                "or albedo/normal/height)")
-    return FolderFiles(albedo=found["albedo"][0][0] if found["albedo"] else None,
-                       normal=normals[0][0] if normals else None,
-                       normal_y=normals[0][1] if normals else "opengl",
-                       height=found["height"][0][0] if found["height"] else None)
 
 
 def clear_cache() -> None:

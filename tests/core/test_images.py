@@ -13,7 +13,7 @@ import pytest
 
 from maptools import cli as maptools_cli
 from wgpuviewer.core.errors import FileError
-from wgpuviewer.core.images import MAX_SIDE, read_header, read_height, read_image
+from wgpuviewer.core.images import MAX_SIDE, ImageBytes, read_header, read_height, read_image
 
 HUGE = 60000  # 60000 x 60000 float32 would be 14.4 GB
 
@@ -41,15 +41,17 @@ EXR_UINT, EXR_HALF, EXR_FLOAT = 0, 1, 2
 
 def huge_exr(path, w=HUGE, h=HUGE, channels=(("Y", EXR_FLOAT, 1),), flags=0, kind=b""):
     """An EXR header and no pixel data: ``channels`` as (name, pixel type, sampling), ``flags`` in the version
-    field, ``kind`` the ``type`` attribute (empty: none)."""
+    field, ``kind`` the ``type`` attribute (empty: none; a deep type comes with the attributes deep data needs)."""
     def attribute(name: bytes, kind: bytes, value: bytes) -> bytes:
         return name + b"\0" + kind + b"\0" + struct.pack("<i", len(value)) + value
 
     chlist = b"".join(name.encode() + b"\0" + struct.pack("<iB3xii", pixel_type, 0, sampling, sampling)
                       for name, pixel_type, sampling in channels) + b"\0"
+    deep = (attribute(b"chunkCount", b"int", struct.pack("<i", h)) + attribute(b"version", b"int", struct.pack("<i", 1))
+            + attribute(b"compression", b"compression", b"\0") if kind.startswith(b"deep") else b"")
     path.write_bytes(b"\x76\x2f\x31\x01" + struct.pack("<i", 2 | flags)
                      + attribute(b"channels", b"chlist", chlist)
-                     + (attribute(b"type", b"string", kind) if kind else b"")
+                     + (attribute(b"type", b"string", kind) if kind else b"") + deep
                      + attribute(b"dataWindow", b"box2i", struct.pack("<4i", 0, 0, w - 1, h - 1)) + b"\0" * 65)
     return path
 
@@ -182,8 +184,8 @@ def test_exr_heights_are_read_through_the_openexr_package(tmp_path):
     ((("Y", EXR_HALF, 2),), 0, b"", "EXR channel 'Y' is subsampled 2x2; expected full resolution"),
     ((("R", EXR_HALF, 1), ("G", EXR_HALF, 1), ("B", EXR_HALF, 1), ("Z", EXR_FLOAT, 1)), 0, b"",
      "EXR channels R, G, B, Z: expected one channel (the height), Y and A, or R, G, B (and A)"),
-    ((("Y", EXR_FLOAT, 1),), 0x800, b"", "deep EXR data"),
-    ((("Y", EXR_FLOAT, 1),), 0x1000, b"deepscanline", "deep EXR data"),
+    ((("Y", EXR_FLOAT, 1),), 0x800, b"deepscanline", "deep EXR data"),
+    ((("Y", EXR_FLOAT, 1),), 0x800, b"", "damaged EXR header"),  # the deep flag without what deep data needs
 ])
 def test_an_exr_we_cannot_use_is_refused_from_its_header(tmp_path, channels, flags, kind, reason):
     path = huge_exr(tmp_path / "h.exr", 8, 8, channels, flags, kind)  # no pixel data: nothing past the header
@@ -191,6 +193,21 @@ def test_an_exr_we_cannot_use_is_refused_from_its_header(tmp_path, channels, fla
         with pytest.raises(FileError) as error:
             read(path)
         assert error.value.reason.startswith(reason), error.value.reason
+
+
+def test_bytes_are_read_like_the_file_that_holds_them(tmp_path, good):
+    """One reader for paths and bytes in memory (an image a glTF embeds): the same header, the same pixels, and
+    problems named by the ImageBytes' name."""
+    height = np.linspace(0, 1, 20 * 12, dtype=np.float32).reshape(12, 20)
+    files = {**good, "exr": write_exr(tmp_path / "y.exr", {"Y": height})}
+    for name, path in files.items():
+        memory = ImageBytes(f"mem.{name}", path.read_bytes())
+        assert read_header(memory) == read_header(path), name
+        assert np.array_equal(read_image(memory), read_image(path)), name
+        assert np.array_equal(read_height(path.read_bytes()), read_height(path)), name
+    with pytest.raises(FileError) as error:
+        read_header(ImageBytes("scene.glb: images[0]", good["png"].read_bytes()[:20]))
+    assert str(error.value) == "scene.glb: images[0]: damaged or truncated PNG header; write or download it again"
 
 
 def test_a_damaged_exr_is_one_line_with_the_decoders_words(tmp_path, capfd):
@@ -271,7 +288,7 @@ def test_only_native_output_during_a_decode_is_taken(tmp_path, capfd, monkeypatc
     import sys
     import threading
 
-    from wgpuviewer.core import images
+    from wgpuviewer.core import native_output
 
     good = tmp_path / "good.png"
     cv2.imwrite(str(good), np.zeros((4, 4), np.uint8))
@@ -285,7 +302,7 @@ def test_only_native_output_during_a_decode_is_taken(tmp_path, capfd, monkeypatc
 
     monkeypatch.setattr(sys, "stderr", sys.__stderr__)  # as in a CLI process: Python's stderr is descriptor 2
     said = []
-    with images._native_stderr(said):
+    with native_output.native_stderr(said):
         chatty(np.fromfile(good, np.uint8), cv2.IMREAD_UNCHANGED)
     other.join(timeout=10)
     err = capfd.readouterr().err

@@ -5,6 +5,7 @@ nor a user's file. SIGTERM, like SIGINT, unwinds: a write in progress leaves no 
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import signal
@@ -121,25 +122,35 @@ def test_stale_temps_of_live_writers_survive_cleanup(tmp_path):
     out = tmp_path / "map.png"
     abandoned = tmp_path / f".{out.name}.killed_9.tmp"
     abandoned.write_bytes(b"left by a kill -9")
-    writing, cleaned = threading.Event(), threading.Event()
+    with writing_in_a_thread(out, b"first", b" writer"):
+        live = [t for t in temps(out) if t != abandoned]
+        assert len(live) == 1
+        assert io.remove_stale_temps(out) == 1  # the abandoned one only
+        assert temps(out) == live
+    assert out.read_bytes() == b"first writer" and temps(out) == []
+
+
+@contextlib.contextmanager
+def writing_in_a_thread(out, first: bytes, last: bytes = b""):
+    """A thread holds ``io.atomic_open(out)`` with ``first`` written while the block runs, then writes ``last``
+    and finishes."""
+    writing, release = threading.Event(), threading.Event()
 
     def writer():
         with io.atomic_open(out) as f:
-            f.write(b"first")
+            f.write(first)
             writing.set()
-            cleaned.wait(30)
-            f.write(b" writer")
+            release.wait(30)
+            f.write(last)
 
     thread = threading.Thread(target=writer)
     thread.start()
     assert writing.wait(30)
-    live = [t for t in temps(out) if t != abandoned]
-    assert len(live) == 1
-    assert io.remove_stale_temps(out) == 1  # the abandoned one only
-    assert temps(out) == live
-    cleaned.set()
-    thread.join(30)
-    assert out.read_bytes() == b"first writer" and temps(out) == []
+    try:
+        yield
+    finally:
+        release.set()
+        thread.join(30)
 
 
 def test_concurrent_batches_into_one_folder_never_fail_each_other(tmp_path, capsys):
@@ -184,37 +195,25 @@ def test_an_output_folder_is_refused_before_anything_is_made(tmp_path, monkeypat
 def test_only_our_abandoned_temps_are_swept(tmp_path):
     """The cleaners take exactly atomic_open's temp names (checked on a live one), unlocked, plain files."""
     out = tmp_path / "plot.png"
-    writing, done = threading.Event(), threading.Event()
-
-    def writer():
-        with io.atomic_open(out) as f:
-            f.write(b"live")
-            writing.set()
-            done.wait(30)
-
-    thread = threading.Thread(target=writer)
-    thread.start()
-    assert writing.wait(30)
-    (live,) = temps(out)
-    assert io.TEMP_NAME.fullmatch(live.name)["target"] == "plot.png"
-    fd, stale = io.tempfile.mkstemp(prefix=".plot.png.", suffix=".tmp", dir=tmp_path)  # as a killed writer left it
-    os.close(fd)
-    users = [".notes.tmp", "draft.tmp", ".plot.png.mine.tmp", ".plot.png.ABCDEFGH.tmp", ".plot.png.abcdefgh.tmpx"]
-    for name in users:
-        (tmp_path / name).write_text("the user's")
-    (tmp_path / ".folder.abcdefgh.tmp").mkdir()
-    (tmp_path / ".link.abcdefgh.tmp").symlink_to(tmp_path / "draft.tmp")
-    assert io.remove_abandoned_temps(tmp_path) == 1 and not os.path.exists(stale)
-    assert io.remove_stale_temps(out) == 0 and live.exists()
-    done.set()
-    thread.join(30)
+    with writing_in_a_thread(out, b"live"):
+        (live,) = temps(out)
+        assert io.TEMP_NAME.fullmatch(live.name)["target"] == "plot.png"
+        fd, stale = io.tempfile.mkstemp(prefix=".plot.png.", suffix=".tmp", dir=tmp_path)  # as a killed writer left it
+        os.close(fd)
+        users = [".notes.tmp", "draft.tmp", ".plot.png.mine.tmp", ".plot.png.ABCDEFGH.tmp", ".plot.png.abcdefgh.tmpx"]
+        for name in users:
+            (tmp_path / name).write_text("the user's")
+        (tmp_path / ".folder.abcdefgh.tmp").mkdir()
+        (tmp_path / ".link.abcdefgh.tmp").symlink_to(tmp_path / "draft.tmp")
+        assert io.remove_abandoned_temps(tmp_path) == 1 and not os.path.exists(stale)
+        assert io.remove_stale_temps(out) == 0 and live.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         [*users, ".folder.abcdefgh.tmp", ".link.abcdefgh.tmp", "plot.png"])
 
 
 WRITER = textwrap.dedent("""
     import sys, time
-    from wgpuviewer.core.cli import run_command
+    from wgpuviewer.core.commands import run_command
     from wgpuviewer.core.io import atomic_open
 
     def command():

@@ -1,6 +1,7 @@
 """``./dev gpu-suite`` (wgpuviewer.lab.gpusuite): the adapter check, the time boxes, a stopped part's record and kept
 rows, the manifest, and the README's headline generated from the newest run (a real GPU's first, else a software
-adapter's named as such); a tiny run end to end on the test adapter, with one part stopped at its time box."""
+adapter's named as such) by ``wgpuviewer docs``, never by a run; a tiny run end to end on the test adapter, with one
+part stopped at its time box."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from wgpuviewer.lab import gpusuite
+from wgpuviewer.lab import docs, gpusuite
 from wgpuviewer.lab.bench import run as bench
 from wgpuviewer.relief.renderer import Renderer  # noqa: F401 - imports wgpu before the log fixture touches its logger
 
@@ -19,14 +20,17 @@ H200 = "NVIDIA H200 (DiscreteGPU) via Vulkan"
 LLVMPIPE = "llvmpipe (LLVM 15.0.6, 256 bits) (CPU) via Vulkan"
 
 
+HEADLINE_BEGIN = docs.BEGIN.format(name="headline")
+
+
 def headline_section(text: str) -> str:
-    return text.split(gpusuite.HEADLINE_BEGIN, 1)[1].split(gpusuite.HEADLINE_END, 1)[0].strip()
+    return text.split(HEADLINE_BEGIN, 1)[1].split(docs.END, 1)[0].strip()
 
 
 def test_the_readme_headline_is_generated_from_the_committed_runs():
-    """Regenerate it with `./dev gpu-suite --headline-only`."""
+    """Regenerate it with `wgpuviewer docs`."""
     text = (ROOT / "README.md").read_text(encoding="utf-8")
-    assert text.count(gpusuite.HEADLINE_BEGIN) == 1
+    assert text.count(HEADLINE_BEGIN) == 1
     assert headline_section(text) == gpusuite.headline_markdown(ROOT / "benchmarks", ROOT).strip()
 
 
@@ -64,14 +68,6 @@ def test_bad_options_are_one_line_errors(argv, names, capsys):
     assert gpusuite.main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("gpu-suite: error:") and names in err and "\n" not in err
-
-
-def test_a_readme_without_the_markers_is_refused_before_measuring(tmp_path, capsys):
-    readme = tmp_path / "README.md"
-    readme.write_text("# no headline here\n")
-    assert gpusuite.main(["--readme", str(readme), "--out-root", str(tmp_path / "runs")]) == 2
-    assert "--readme" in capsys.readouterr().err
-    assert not (tmp_path / "runs").exists()
 
 
 # --- the headline from fixture runs ----------------------------------------------------------------------------
@@ -141,18 +137,23 @@ def test_without_a_gpu_run_the_headline_names_the_software_adapter(tmp_path):
     assert "SMs" not in text
 
 
-def test_headline_only_rewrites_only_the_section(tmp_path):
+def test_the_docs_command_rewrites_only_the_headline_from_a_new_run(tmp_path, capsys):
     runs = tmp_path / "benchmarks"
     fixture_run(runs, "nvidia-h200", H200, False, "2026-12-01T10:00:00Z")
     readme = tmp_path / "README.md"
     shutil.copy(ROOT / "README.md", readme)
     before = readme.read_text(encoding="utf-8")
-    assert gpusuite.main(["--headline-only", "--readme", str(readme), "--out-root", str(runs)]) == 0
+    assert docs.run(tmp_path, check=True) == 1  # the page is not the new run's yet: named, nothing written
+    assert "README.md: block 'headline' differs" in capsys.readouterr().out
+    assert readme.read_text(encoding="utf-8") == before
+    assert docs.run(tmp_path, check=False) == 0
+    assert capsys.readouterr().out.splitlines() == ["README.md: block 'headline' regenerated from the newest "
+                                                    "./dev gpu-suite run under benchmarks/"]
     after = readme.read_text(encoding="utf-8")
     assert headline_section(after) == gpusuite.headline_markdown(runs, tmp_path)
-    assert after.split(gpusuite.HEADLINE_BEGIN)[0] == before.split(gpusuite.HEADLINE_BEGIN)[0]
-    assert after.split(gpusuite.HEADLINE_BEGIN)[1].split(gpusuite.HEADLINE_END, 1)[1] == \
-        before.split(gpusuite.HEADLINE_BEGIN)[1].split(gpusuite.HEADLINE_END, 1)[1]
+    assert after.split(HEADLINE_BEGIN)[0] == before.split(HEADLINE_BEGIN)[0]
+    assert after.split(HEADLINE_BEGIN)[1].split(docs.END, 1)[1] == before.split(HEADLINE_BEGIN)[1].split(docs.END, 1)[1]
+    assert docs.run(tmp_path, check=True) == 0
 
 
 def test_a_stopped_bench_gets_its_report_from_the_views_it_finished(tmp_path):
@@ -170,15 +171,13 @@ def test_a_stopped_bench_gets_its_report_from_the_views_it_finished(tmp_path):
 @pytest.fixture(scope="module")
 def tiny_run(tmp_path_factory, adapter):
     """`--suite tiny` with perspective's box far shorter than it takes: bench and filtering finish, perspective
-    is stopped; into a temp output root and a temp copy of the README."""
+    is stopped; into a temp output root."""
     root = tmp_path_factory.mktemp("gpu-suite")
-    readme = root / "README.md"
-    shutil.copy(ROOT / "README.md", readme)
     code = gpusuite.main(["--suite", "tiny", "--allow-software", "--box", "perspective=2", "--out-root",
-                          str(root / "benchmarks"), "--readme", str(readme)])
+                          str(root / "benchmarks")])
     folders = [p.parent for p in (root / "benchmarks").glob(f"*/{gpusuite.MANIFEST}")]
     assert len(folders) == 1
-    return code, folders[0], readme
+    return code, folders[0], root
 
 
 @pytest.mark.requires_gpu
@@ -214,10 +213,14 @@ def test_tiny_run_records_every_part_and_stops_the_one_past_its_box(tiny_run, ad
 
 
 @pytest.mark.requires_gpu
-def test_tiny_run_regenerates_the_headline_naming_the_software_adapter(tiny_run, adapter):
-    _, folder, readme = tiny_run
-    section = headline_section(readme.read_text(encoding="utf-8"))
-    assert section == gpusuite.headline_markdown(folder.parent, readme.parent)
+def test_the_headline_of_a_tiny_run_names_the_software_adapter(tiny_run, adapter):
+    _, folder, root = tiny_run
+    assert not (root / "README.md").exists()  # a run writes no page
+    shutil.copy(ROOT / "README.md", root / "README.md")
+    _, new, changed = docs.regenerate(root, root / "README.md")
+    assert changed == ["headline"]
+    section = headline_section(new)
+    assert section == gpusuite.headline_markdown(folder.parent, root)
     assert f"**{adapter}**" in section and f"benchmarks/{folder.name}/bench/report.md" in section
     if "(CPU)" in adapter:
         assert "is a software adapter" in section

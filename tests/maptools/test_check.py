@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from maptools import check, cli, registry
-from maptools import cone as cn
-from maptools import distance as dist
-from maptools import refined as rf
+from maptools.kinds.cone import cpu as cn
+from maptools.kinds.distance_refined import cpu as rf
+from maptools.volume import cpu as dist
 from tests.maptools.helpers import adversarial_maps, smooth_tileable
 from wgpuviewer.lab.studies.refined_distance import reliefs
 
@@ -31,20 +31,21 @@ def random_index(shape, n: int, seed: int) -> tuple[np.ndarray, ...]:
                                   {"slices": 2, "height_scale": 1.0, "subcells": 8}])
 @pytest.mark.parametrize("name", list(MAPS))
 def test_distance_sample_equals_full(name, opts):
-    h = MAPS[name]
-    full = dist.distance(h, **opts)
-    index = random_index(full.shape, 200, len(name))
-    values = dist.sample_reference(h, index, **opts)
-    assert values.dtype == full.dtype and np.array_equal(values, full[index])
+    assert_sample_equals_full(dist.distance, dist.sample_reference, name, opts)
 
 
 @pytest.mark.parametrize("opts", [{"filter": "nearest"}, {"filter": "bilinear"}, {"max_ratio": 2.5}])
 @pytest.mark.parametrize("name", list(MAPS))
 def test_cone_sample_equals_full(name, opts):
+    assert_sample_equals_full(cn.cone, cn.sample_reference, name, opts)
+
+
+def assert_sample_equals_full(reference, sample_reference, name: str, opts: dict) -> None:
+    """The sampled reference at 200 seeded indices equals the whole reference there, value and dtype."""
     h = MAPS[name]
-    full = cn.cone(h, **opts)
+    full = reference(h, **opts)
     index = random_index(full.shape, 200, len(name))
-    values = cn.sample_reference(h, index, **opts)
+    values = sample_reference(h, index, **opts)
     assert values.dtype == full.dtype and np.array_equal(values, full[index])
 
 

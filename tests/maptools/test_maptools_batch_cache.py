@@ -186,6 +186,7 @@ def test_an_edited_kernel_changes_the_cache_and_batch_keys(monkeypatch):
     serves a map the old kernel built; kinds that do not run the edited file keep their keys."""
     import argparse
 
+    from maptools.volume import gpu as volume_gpu
     from wgpuviewer.core import wgsl
 
     h = smooth_tileable(16, 16, 0)
@@ -199,7 +200,7 @@ def test_an_edited_kernel_changes_the_cache_and_batch_keys(monkeypatch):
     before = keys()
     read = wgsl.read_wgsl
     for edited, changed in (("common/sobel.wgsl", {"normal", "complexity"}),
-                            ("maps/distance.wgsl", {"distance_refined"})):
+                            (str(volume_gpu.KERNEL.path), {"distance_refined"})):
         monkeypatch.setattr(wgsl, "read_wgsl", lambda name, edited=edited: read(name) + ("// edited\n" if name == edited
                                                                                      else ""))
         after = keys()

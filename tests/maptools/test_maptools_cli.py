@@ -13,6 +13,8 @@ import pytest
 
 import maptools
 from maptools import cache, cli, io, registry
+from maptools.kinds.maxmip import cpu as maxmip_cpu
+from maptools.kinds.maxmip.io import read_maxmip
 from tests.maptools.helpers import smooth_tileable
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.images import read_height
@@ -109,7 +111,7 @@ def test_writers_round_trip(tmp_path):
     assert np.array_equal(cv2.imread(str(tmp_path / "c.png"), cv2.IMREAD_UNCHANGED), c)
     levels = maptools.generate("maxmip", h, backend="cpu")
     io.write_result(registry.KINDS["maxmip"], levels, tmp_path / "m.npz")
-    assert all(np.array_equal(a, b) for a, b in zip(io.read_maxmip(tmp_path / "m.npz"), levels))
+    assert all(np.array_equal(a, b) for a, b in zip(read_maxmip(tmp_path / "m.npz"), levels))
     with pytest.raises(UserError, match=".npz"):
         io.write_result(registry.KINDS["maxmip"], levels, tmp_path / "m.png")
     assert leftovers(tmp_path) == []
@@ -209,7 +211,7 @@ def test_cli_check(inputs, capsys, monkeypatch):
     assert cli.main(["check", str(d / "b8.png")]) == 0
     out = capsys.readouterr().out
     assert out.count("OK") == len(registry.KINDS) and "MISMATCH" not in out
-    bad = dataclasses.replace(registry.KINDS["maxmip"], gpu=lambda h: [x + 1 for x in registry.cpu.maxmip(h)])
+    bad = dataclasses.replace(registry.KINDS["maxmip"], gpu=lambda h: [x + 1 for x in maxmip_cpu.maxmip(h)])
     monkeypatch.setitem(registry.KINDS, "maxmip", bad)
     assert cli.main(["check", str(d / "a.npy"), "--kinds", "maxmip"]) == 1
     assert "MISMATCH" in capsys.readouterr().out

@@ -11,7 +11,8 @@ import pytest
 
 import maptools
 from maptools import cli
-from maptools import cone as cn
+from maptools.kinds.cone import cpu as cn
+from maptools.kinds.cone import io as cone_io
 from maptools.registry import KINDS
 from maptools.trace import BRACKETED, CAPPED, GAP_STOP, cone_trace
 from tests.maptools.helpers import adversarial_maps, smooth_tileable
@@ -136,9 +137,9 @@ def test_png_rounds_down_and_cli(tmp_path):
                          "--bits", str(bits)]) == 0
         img = cv2.imread(str(out), cv2.IMREAD_UNCHANGED)
         assert img.dtype == (np.uint8 if bits == 8 else np.uint16) and img.shape == h.shape
-        back = cn.decode_png(img)
+        back = cone_io.decode_png(img)
         assert (back <= ref).all()
-        assert np.abs(np.sqrt(back) - np.sqrt(ref)).max() <= np.sqrt(cn.PNG_SCALE) / ((1 << bits) - 1) + 1e-6
+        assert np.abs(np.sqrt(back) - np.sqrt(ref)).max() <= np.sqrt(cone_io.PNG_SCALE) / ((1 << bits) - 1) + 1e-6
     assert cli.main(["generate", "cone", str(tmp_path / "h.npy"), "-o", str(tmp_path / "c.npz")]) == 2
 
 

@@ -12,10 +12,14 @@ import pytest
 
 import maptools
 from maptools import cli, gpu
-from maptools import distance as dist
-from maptools import refined as rf
+from maptools.kinds.distance import gpu as distance_gpu
+from maptools.kinds.distance_refined import bins as rb
+from maptools.kinds.distance_refined import gpu as refined_gpu
+from maptools.kinds.distance_refined import visibility as rv
 from maptools.registry import KINDS
 from maptools.trace import sphere_trace
+from maptools.volume import cpu as dist
+from maptools.volume import gpu as volume_gpu
 from tests.maptools.helpers import adversarial_maps, smooth_tileable
 from wgpuviewer.core.compute import Compute
 from wgpuviewer.core.errors import UserError
@@ -171,11 +175,11 @@ def sample_wedge_rect(x0, x1, y0, y1, b, n=4000):
 
 @pytest.mark.parametrize("sectors", [1, 2, 4, 8, 16])
 def test_wedge_rho_is_the_least_length_in_the_wedge(sectors):
-    for b in rf.bins(sectors, 1, 80.0):
+    for b in rb.bins(sectors, 1, 80.0):
         for _ in range(40):
             x0, y0 = RNG.uniform(-6, 6, 2)
             x1, y1 = x0 + RNG.uniform(0, 4), y0 + RNG.uniform(0, 4)
-            rho = float(rf.wedge_rho(np.array([x0]), np.array([x1]), np.array([y0]), np.array([y1]), b)[0])
+            rho = float(rb.wedge_rho(np.array([x0]), np.array([x1]), np.array([y0]), np.array([y1]), b)[0])
             sampled = sample_wedge_rect(x0, x1, y0, y1, b)
             assert rho <= sampled + 1e-12  # never above any point of the rect in the wedge
             if np.isfinite(sampled):
@@ -187,8 +191,8 @@ def test_entries_cover_every_column_in_reach_once(sectors, sy, reach):
     """Each sub-cell offset within reach of the bin lies in exactly one final entry; entries never claim a rho
     above the least rho of the sub-cells they stand for."""
     k = 4
-    b = rf.bins(sectors, 1, 80.0)[sectors // 2]
-    e = rf.entries(b, k, sy, reach)
+    b = rb.bins(sectors, 1, 80.0)[sectors // 2]
+    e = rb.entries(b, k, sy, reach)
     ax, ay = 0.5 + dist.BOX_GROW, 0.5 * sy + dist.BOX_GROW
     covered: dict[tuple[int, int], int] = {}
     for q in np.flatnonzero(e.final):
@@ -199,7 +203,7 @@ def test_entries_cover_every_column_in_reach_once(sectors, sy, reach):
             subs = [(k * (e.ox[q] + cx) + u, k * (e.oy[q] + cy) + v)
                     for cx in range(size) for cy in range(size) for u in range(k) for v in range(k)]
         sx, sy_ = np.array(subs).T
-        srho = rf.wedge_rho(sx / k - ax, (sx + 1) / k + ax, sy_ / k * sy - ay, (sy_ + 1) / k * sy + ay, b)
+        srho = rb.wedge_rho(sx / k - ax, (sx + 1) / k + ax, sy_ / k * sy - ay, (sy_ + 1) / k * sy + ay, b)
         assert e.rho[q] <= srho.min() + 1e-12
         for s in subs:
             covered[s] = covered.get(s, 0) + 1
@@ -207,7 +211,7 @@ def test_entries_cover_every_column_in_reach_once(sectors, sy, reach):
     r = math.ceil(reach * k) + 2 * k
     oy, ox = np.mgrid[-r:r + 1, -r:r + 1]
     ox, oy = ox.ravel(), oy.ravel()
-    srho = rf.wedge_rho(ox / k - ax, (ox + 1) / k + ax, oy / k * sy - ay, (oy + 1) / k * sy + ay, b)
+    srho = rb.wedge_rho(ox / k - ax, (ox + 1) / k + ax, oy / k * sy - ay, (oy + 1) / k * sy + ay, b)
     need = {(int(x), int(y)) for x, y, q in zip(ox, oy, srho) if q < reach}
     assert need <= set(covered)
     heads = np.flatnonzero(e.children > 0)
@@ -217,23 +221,23 @@ def test_entries_cover_every_column_in_reach_once(sectors, sy, reach):
 
 
 def test_band_edges_have_equal_cosine_ratios():
-    edges = rf.band_edges(8, 80.0)
+    edges = rb.band_edges(8, 80.0)
     cos = np.cos([0.0, *edges, np.radians(80.0)])
     assert len(edges) == 7 and np.allclose(cos[1:] / cos[:-1], np.cos(np.radians(80.0)) ** (1 / 8))
-    assert rf.band_edges(1, 80.0) == []
+    assert rb.band_edges(1, 80.0) == []
 
 
 def test_bins_and_the_tracers_choice():
     """volume_index picks the bin whose azimuth sector and polar band hold the ray's direction (w = (-V.x, -V.y,
     V.z)), rays steeper than max_angle the plain volume (last); the bins tile the cone."""
-    bins = rf.bins(8, 4, 80.0)
+    bins = rb.bins(8, 4, 80.0)
     assert len(bins) == 32
-    edges = np.degrees(rf.band_edges(4, 80.0))
+    edges = np.degrees(rb.band_edges(4, 80.0))
     theta = np.concatenate([RNG.uniform(0, 89.9, 4000), edges, [0.0, 80.0, 80.001, 89.0]])
     phi = RNG.uniform(0, 360, len(theta))
     phi[-8:] = (0, 45, 90, 135, 180, 225, 270, 315)
     v = view_dir_from_angles(theta, phi)
-    which = rf.volume_index(v, 8, 4, 80.0)
+    which = rb.volume_index(v, 8, 4, 80.0)
     w = v * [-1, -1, 1]
     polar = np.arccos(np.clip(w[:, 2], -1, 1))
     az = np.arctan2(w[:, 1], w[:, 0])
@@ -300,16 +304,16 @@ def test_sphere_tracing_never_tunnels(name, s, slices):
     rng = np.random.default_rng(len(name))
     plain = maptools.generate("distance", h, backend="cpu", slices=slices, height_scale=s)
     uv, v = cone_rays(1500, 89.0, rng)
-    uv2, v2 = adversarial_rays(120, h.shape, np.degrees(rf.band_edges(BANDS, 80.0)), 8, rng)
+    uv2, v2 = adversarial_rays(120, h.shape, np.degrees(rb.band_edges(BANDS, 80.0)), 8, rng)
     uv, v = np.concatenate([uv, uv2]), np.concatenate([v, v2])
     hit = exact_hit(1.0 - h.astype(np.float64), uv, v, s)
     assert hit.valid.all()
     maps = [("plain", plain, None)]
-    for visibility in rf.VISIBILITY_CHOICES:
+    for visibility in rb.VISIBILITY_CHOICES:
         for sectors, bands in ((8, BANDS), (1, 1)):
             vol = maptools.generate("distance_refined", h, backend="cpu", slices=slices, height_scale=s,
                                     sectors=sectors, bands=bands, reach=8.0, max_angle=80.0, visibility=visibility)
-            maps.append((f"{sectors}x{bands} {visibility}", vol, rf.volume_index(v, sectors, bands, 80.0)))
+            maps.append((f"{sectors}x{bands} {visibility}", vol, rb.volume_index(v, sectors, bands, 80.0)))
     for label, vol, which in maps:
         t, _, _ = sphere_trace(vol, uv, v, s, stop=1e-3, max_steps=600, which=which)
         assert (t <= hit.t + 1e-9).all(), f"{label}: {int((t > hit.t + 1e-9).sum())} rays tunnelled"
@@ -329,7 +333,7 @@ def free_paths(depth, p, w, s):
     return (hit.t - t_p) * per_t, hit.valid & (hit.t >= t_p)
 
 
-@pytest.mark.parametrize("visibility", rf.VISIBILITY_CHOICES)
+@pytest.mark.parametrize("visibility", rb.VISIBILITY_CHOICES)
 @pytest.mark.parametrize("name", ["walls", "spike", "checker", "smooth_40x24", "wall", "step", "noise_odd", "plate",
                                   "grille"])
 def test_refined_value_never_exceeds_the_free_path(name, visibility):
@@ -348,13 +352,13 @@ def test_refined_value_never_exceeds_the_free_path(name, visibility):
     uv = rng.random((n, 2))
     t = sample_bilinear(depth, uv) * rng.random(n)  # above the surface: the states a ray may be in
     p = np.stack([uv[:, 0] * cols, uv[:, 1] * cols, t * s * cols], axis=1)
-    bins = rf.bins(8, BANDS, 80.0)
+    bins = rb.bins(8, BANDS, 80.0)
     which = rng.integers(0, len(bins), n)
     lo = np.array([b.polar_lo for b in bins])[which]
-    hi = np.array([b.polar_hi for b in bins])[which] - rf.ANGLE_SLACK
+    hi = np.array([b.polar_hi for b in bins])[which] - rb.ANGLE_SLACK
     polar = np.arccos(np.cos(lo) - rng.random(n) * (np.cos(lo) - np.cos(hi)))
     polar = np.where(rng.random(n) < 0.1, hi, polar)  # on the band's far edge too
-    az_lo = np.array([b.az_lo for b in bins])[which] + rf.ANGLE_SLACK
+    az_lo = np.array([b.az_lo for b in bins])[which] + rb.ANGLE_SLACK
     az = az_lo + rng.random(n) * 2 * np.pi / 8
     az = np.where(rng.random(n) < 0.1, az_lo, az)  # on the sector's edge too
     w = np.stack([np.sin(polar) * np.cos(az), np.sin(polar) * np.sin(az), np.cos(polar)], axis=1)
@@ -392,13 +396,13 @@ def test_horizon_rings_hold_every_cell_a_shifted_footprint_touches(sectors, sy):
     cell holding f - x u (its offset from the voxel's own cell) is in ring n."""
     reach = 6.0
     rng = np.random.default_rng(sectors)
-    for b in rf.bins(sectors, 1, 80.0):
-        rings = [set(zip(ox.tolist(), oy.tolist())) for ox, oy in rf.horizon_rings(b, sy, reach)]
-        assert len(rings) == rf.ring_count(reach)
+    for b in rb.bins(sectors, 1, 80.0):
+        rings = [set(zip(ox.tolist(), oy.tolist())) for ox, oy in rv.horizon_rings(b, sy, reach)]
+        assert len(rings) == rv.ring_count(reach)
         az = b.az_lo + rng.random(4000) * (b.az_hi - b.az_lo) if not b.full else rng.random(4000) * 2 * np.pi
         f = rng.random((4000, 2)) * [1.0, sy]
         for n, ring in enumerate(rings, start=1):
-            x = n * rf.HORIZON_STEP
+            x = n * rb.HORIZON_STEP
             q = f - x * np.stack([np.cos(az), np.sin(az)], axis=1)
             # cell c covers [c + 0.5, c + 1.5] x [c + 0.5, c + 1.5] sy: the texel-centre grid
             cells = set(zip(np.floor(q[:, 0] - 0.5).astype(int).tolist(),
@@ -415,17 +419,17 @@ def test_directions_past_the_cut_cannot_reach_the_voxel(name):
     rows, cols = h.shape
     slices, s, sectors = 8, 0.4, 4
     depth = 1.0 - h.astype(np.float64)
-    cut = rf.horizon(depth, slices, s, sectors, 80.0, 8.0)
+    cut = rv.horizon(depth, slices, s, sectors, 80.0, 8.0)
     rng = np.random.default_rng(7)
-    bins = rf.bins(sectors, 1, 80.0)
+    bins = rb.bins(sectors, 1, 80.0)
     sec, k, j, i = (a[rng.permutation(a.size)[:3000]] for a in np.nonzero(cut > 0))
     assert sec.size > 100
     dz = s * cols / slices
     p = np.stack([i + rng.random(i.size), (j + rng.random(j.size)) * cols / rows,
                   (k + rng.random(k.size)) * dz], axis=1)
-    polar = np.arctan2(1.0, cut[sec, k, j, i]) + 1.5 * rf.ANGLE_SLACK
+    polar = np.arctan2(1.0, cut[sec, k, j, i]) + 1.5 * rb.ANGLE_SLACK
     polar = np.minimum(polar + rng.random(polar.size) * (np.pi / 2 - polar) * 0.5, np.radians(89.9))
-    az_lo = np.array([b.az_lo + rf.ANGLE_SLACK for b in bins])[sec]
+    az_lo = np.array([b.az_lo + rb.ANGLE_SLACK for b in bins])[sec]
     az = az_lo + rng.random(sec.size) * 2 * np.pi / sectors
     w = np.stack([np.sin(polar) * np.cos(az), np.sin(polar) * np.sin(az), np.cos(polar)], axis=1)
     _, reachable = free_paths(depth, p, w, s)
@@ -474,11 +478,11 @@ def test_gpu_bakes_in_slabs_where_the_volume_is_beyond_the_storage_limit(monkeyp
     h = MAPS["smooth_40x24"]
     opts = {"slices": 5, "height_scale": 0.3, "subcells": 2}
     refined = {**opts, "sectors": 2, "bands": 6}
-    whole = gpu.distance(h, **opts), gpu.distance_refined(h, progress=False, **refined)
-    _, per_slice = gpu.bake_buffers(40, 24, 2, rf.BANDS_PER_PASS)
+    whole = distance_gpu.distance(h, **opts), refined_gpu.distance_refined(h, progress=False, **refined)
+    _, per_slice = volume_gpu.bake_buffers(40, 24, 2, rb.BANDS_PER_PASS)
     monkeypatch.setattr(Compute, "max_buffer", property(lambda self: 2 * per_slice))
-    assert gpu._slab_slices(gpu.runner(), 40, 24, 5, 2, rf.BANDS_PER_PASS) == 2  # slabs of 2, 2 and 1 slices
-    slabs = gpu.distance(h, **opts), gpu.distance_refined(h, progress=False, **refined)
+    assert volume_gpu.slab_slices(gpu.runner(), 40, 24, 5, 2, rb.BANDS_PER_PASS) == 2  # slabs of 2, 2 and 1 slices
+    slabs = distance_gpu.distance(h, **opts), refined_gpu.distance_refined(h, progress=False, **refined)
     assert np.array_equal(slabs[0], whole[0]) and np.array_equal(slabs[1], whole[1])
     for kind, options, result in (("distance", opts, slabs[0]), ("distance_refined", refined, slabs[1])):
         c = KINDS[kind].compare(maptools.generate(kind, h, backend="cpu", **options), result,
@@ -487,14 +491,14 @@ def test_gpu_bakes_in_slabs_where_the_volume_is_beyond_the_storage_limit(monkeyp
 
 
 def test_fitting_subcells_follow_the_storage_limit():
-    once, per_slice = gpu.bake_buffers(100, 50, 4)
+    once, per_slice = volume_gpu.bake_buffers(100, 50, 4)
     assert (once, per_slice) == (100 * 50 * 16 * 4, 100 * 50 * 4 * 4)
-    assert gpu.bake_buffers(100, 50, 1, rf.BANDS_PER_PASS) == (100 * 50 * 4, 100 * 50 * 4 * rf.BANDS_PER_PASS)
-    assert gpu.fitting_subcells(100, 50, once) == 4
-    assert gpu.fitting_subcells(100, 50, once - 1) == 2
-    assert gpu.fitting_subcells(100, 50, once, most=2) == 2
-    assert gpu.fitting_subcells(100, 50, 100 * 50 * 4) == 1
-    assert gpu.fitting_subcells(100, 50, 100 * 50 * 4, lanes=rf.BANDS_PER_PASS) is None
+    assert volume_gpu.bake_buffers(100, 50, 1, rb.BANDS_PER_PASS) == (100 * 50 * 4, 100 * 50 * 4 * rb.BANDS_PER_PASS)
+    assert volume_gpu.fitting_subcells(100, 50, once) == 4
+    assert volume_gpu.fitting_subcells(100, 50, once - 1) == 2
+    assert volume_gpu.fitting_subcells(100, 50, once, most=2) == 2
+    assert volume_gpu.fitting_subcells(100, 50, 100 * 50 * 4) == 1
+    assert volume_gpu.fitting_subcells(100, 50, 100 * 50 * 4, lanes=rb.BANDS_PER_PASS) is None
 
 
 @pytest.mark.requires_gpu

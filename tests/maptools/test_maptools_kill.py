@@ -52,7 +52,7 @@ def test_sigkill_mid_batch_leaves_only_complete_outputs(tmp_path, capsys):
     for p in outputs:  # every output present is complete: it loads and equals a fresh single generate
         stem, kind = p.name.split(".")[:2]
         if kind == "maxmip":
-            from maptools.io import read_maxmip
+            from maptools.kinds.maxmip.io import read_maxmip
 
             got, want = read_maxmip(p), maptools.generate("maxmip", maps[stem], backend="cpu")
             assert all(np.array_equal(a, b) for a, b in zip(got, want))

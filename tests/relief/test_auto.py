@@ -1,28 +1,29 @@
-"""auto: the error budget as a technique (wgsl/techniques/auto.wgsl, relief/autotable.py). The shader picks the bin
-and budget level the table was built for, runs exactly the chosen candidate's code, keeps the p95 UV error within
-the budget at 0-80 degrees on the benchmark's maps and the hard cases, and its table is measured once per material
-and then read from the disk cache."""
+"""auto: the error budget as a technique (wgpuviewer/techniques/auto/: auto.wgsl, autotable.py, its slot). The
+shader picks the bin and budget level the table was built for, runs exactly the chosen candidate's code, keeps the
+p95 UV error within the budget at 0-80 degrees on the benchmark's maps and the hard cases, and its table is measured
+once per material and then read from the disk cache."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from wgpuviewer.relief import autotable
 from wgpuviewer.relief.accuracy import npot_height, random_rays
 from wgpuviewer.relief.output import mode_data
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.scene import load_scene
-from wgpuviewer.techniques import AUTO_BINS, AUTO_CANDIDATES, AUTO_TAN0, TECHNIQUES
+from wgpuviewer.techniques import TECHNIQUES
+from wgpuviewer.techniques.auto import autotable
+from wgpuviewer.techniques.auto.autotable import AUTO_BINS, AUTO_CANDIDATES, AUTO_TAN0
 from wgpuviewer.textures import builtin_height
 
 from .test_render import GOLDEN
 
 
 def table_of(height: np.ndarray, height_scale: float = 0.05) -> np.ndarray:
-    return autotable.measure(1.0 - np.asarray(height, np.float32), height_scale, probe)
+    return autotable.measure(1.0 - np.asarray(height, np.float32), height_scale)
 
 
 def test_scaled_layers_keep_the_horizontal_spacing_inside_a_bin():
@@ -145,7 +146,7 @@ def test_npot_map_and_a_larger_relief(gpu):
     assert (p95 <= 0.5).all(), p95
 
 
-def test_the_table_is_measured_once_then_read_from_the_cache(gpu):
+def test_the_table_is_measured_once_then_read_from_the_cache(gpu, monkeypatch):
     h = builtin_height("ridges", (32, 32))
     first = table_of(h)
     assert first.shape == (len(AUTO_CANDIDATES) + len(autotable.SCALED), len(autotable.edge_angles()),
@@ -154,7 +155,9 @@ def test_the_table_is_measured_once_then_read_from_the_cache(gpu):
     def no_probe(*args, **kwargs):
         raise AssertionError("the cached table should have been used")
 
-    np.testing.assert_array_equal(autotable.measure(1.0 - h.astype(np.float32), 0.05, no_probe), first)
+    monkeypatch.setattr("wgpuviewer.relief.probe.probe", no_probe)
+    np.testing.assert_array_equal(autotable.measure(1.0 - h.astype(np.float32), 0.05), first)
+    monkeypatch.undo()
     # another height scale is another table (the slot is scale-bound)
     assert not np.array_equal(table_of(h, 0.1), first)
 
@@ -174,6 +177,7 @@ def test_debug_view_and_registry_entry(gpu):
     """The layers mode paints the chosen candidate (1-based, cheapest first) as grey."""
     tech = TECHNIQUES["auto"]
     assert tech.ray_search and not tech.exact and "auto_table" in tech.textures
+    assert [slot.name for slot in tech.slots] == ["auto_table"]  # its own slot, declared in its folder
     assert tech.fetch_bound(tech.defaults()) >= TECHNIQUES["quadmax"].fetch_bound(TECHNIQUES["quadmax"].defaults())
     assert tech.layer_range(tech.defaults()) == (1.0, float(len(AUTO_CANDIDATES)))
     renderer = Renderer(load_scene(GOLDEN / "scene.toml"), gpu)

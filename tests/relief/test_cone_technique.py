@@ -1,4 +1,4 @@
-"""The `cone` technique (robust relaxed cone stepping, wgsl/techniques/cone.wgsl): exact on the bilinear surface
+"""The `cone` technique (robust relaxed cone stepping, wgpuviewer/techniques/cone/): exact on the bilinear surface
 (never behind the float64 first hit, on it to float32 precision), every step leaving the current cell, bounded
 and flagged at grazing views, fetch counts within the registry's bound."""
 
@@ -8,23 +8,18 @@ import numpy as np
 import pytest
 
 from maptools.cache import cached_generate
+from maptools.kinds.cone.slot import CONE_FILTER, CONE_MAX_RATIO, footprint_min_depth
 from wgpuviewer.cli import main
 from wgpuviewer.core.gpu import _TEXEL, _texel_band
 from wgpuviewer.core.sampling import bilinear
 from wgpuviewer.core.wgsl import read_wgsl
 from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
-from wgpuviewer.relief.maps import MAP_SLOTS, footprint_min_depth
+from wgpuviewer.relief.maps import MAP_SLOTS
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
-from wgpuviewer.techniques import (
-    CONE_FILTER,
-    CONE_FINISH_CELLS,
-    CONE_HALVINGS_MAX,
-    CONE_MAX_RATIO,
-    HANDOVER_STEPS,
-    PYRAMID_STEPS,
-    TECHNIQUES,
-)
+from wgpuviewer.techniques import TECHNIQUES
+from wgpuviewer.techniques.cone import CONE_FINISH_CELLS, CONE_HALVINGS_MAX
+from wgpuviewer.techniques.shared import HANDOVER_STEPS, PYRAMID_STEPS
 from wgpuviewer.textures import builtin_height
 
 REAL = ("bricks", "bumps", "ridges")
@@ -42,7 +37,7 @@ def height_map(name: str, size=(64, 64)) -> np.ndarray:
 
 def test_registry_entry_and_map_slot():
     tech = TECHNIQUES["cone"]
-    assert tech.ray_search and tech.exact and tech.wgsl_file == "techniques/cone.wgsl" and "cone" in tech.textures
+    assert tech.ray_search and tech.exact and tech.wgsl_file.endswith("/cone/cone.wgsl") and "cone" in tech.textures
     assert tech.defaults() == {"iterations": 128}
     assert tech.fixed_values() == {"max_ratio": CONE_MAX_RATIO, "halvings_max": CONE_HALVINGS_MAX,
                                 "finish_cells": CONE_FINISH_CELLS, "handover_steps": HANDOVER_STEPS,

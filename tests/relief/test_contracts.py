@@ -11,10 +11,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from wgpuviewer.core.params import resolve_params
 from wgpuviewer.relief.accuracy import random_rays
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
-from wgpuviewer.techniques import TECHNIQUES, resolve_params
+from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.textures import builtin_height
 
 RAY_SEARCH = [name for name, t in TECHNIQUES.items() if t.ray_search]

@@ -2,8 +2,8 @@
 (TraceParams, the render entry's Frame and Object, the parameter constants, the binding lines of a technique's
 texture slots, the entries' own records: the probe's rays and hits, the filter probe's samples and results, the
 error view's Blit, the offscreen targets' DataOut), and the entry files declare none of them. A throw-away technique
-with a new parameter and a new map slot renders and probes without touching any other file, its hits read back
-field by field where the GPU wrote them."""
+with a new parameter and a new map slot, one folder found by discovery, renders and probes without touching any other
+file, its hits read back field by field where the GPU wrote them."""
 
 from __future__ import annotations
 
@@ -13,14 +13,14 @@ import numpy as np
 import pytest
 
 from tests.relief.scenes import plane_scene
-from wgpuviewer.core.gpu import create_texture
+from tests.relief.technique_folder import technique_folder
 from wgpuviewer.core.structs import FragmentOutputs
 from wgpuviewer.core.wgsl import read_wgsl
 from wgpuviewer.relief import filter_probe, maps, probe, renderer, shaders
-from wgpuviewer.relief.maps import MAP_SLOTS, MapSlot
+from wgpuviewer.relief.maps import MAP_SLOTS
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.scene import parse_scene
-from wgpuviewer.techniques import TECHNIQUES, Param, Technique
+from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.viewer import error_view
 
 #: Every entry file and the records Python generates for it (composed in before it: the entry never declares them).
@@ -101,21 +101,34 @@ fn trace(uv0: vec2f, v: vec3f, lod: f32) -> TraceResult {
 }
 """
 
+TOY_INIT = '''"""A throw-away technique with its own parameter and its own map slot (a constant 0.25)."""
+
+import numpy as np
+
+from wgpuviewer.core.gpu import create_texture
+from wgpuviewer.core.params import Param
+from wgpuviewer.core.slots import FILTERABLE_2D, TEXTURE_2D, MapSlot
+from wgpuviewer.techniques import Technique
+
+
+def build_toy(gpu, depth, height_scale, label):
+    return create_texture(gpu, [np.full(depth.shape, 0.25, np.float32)], gpu.depth_format, label)
+
+
+TECHNIQUE = Technique(
+    "toy", "-", "interface test", "1 depth fetch", ("albedo", "depth", "toy"),
+    (Param("gain", 1.0, 0.0, 4.0, float, "shift per map unit"),), ray_search=True, order=1000,
+    fetch_bound=lambda p: 1,
+    slots=(MapSlot("toy", TEXTURE_2D, FILTERABLE_2D, build_toy, "a constant 0.25, for the interface test", order=1000),),
+)
+'''
+
+
 @pytest.fixture
-def toy(tmp_path, monkeypatch):
-    wgsl_file = tmp_path / "toy.wgsl"
-    wgsl_file.write_text(TOY_WGSL)
-
-    def build(gpu, depth, height_scale, label):
-        return create_texture(gpu, [np.full(depth.shape, 0.25, np.float32)], gpu.depth_format, label)
-
-    monkeypatch.setitem(MAP_SLOTS, "toy", MapSlot("toy", "texture_2d<f32>", maps.MAP_SLOTS["depth"].layout, build,
-                                                  "a constant 0.25, for the interface test"))
-    technique = Technique("toy", "-", "interface test", "1 depth fetch", ("albedo", "depth", "toy"),
-                          (Param("gain", 1.0, 0.0, 4.0, float, "shift per map unit"),), ray_search=True,
-                          wgsl=str(wgsl_file), fetch_bound=lambda p: 1)
-    monkeypatch.setitem(TECHNIQUES, "toy", technique)
-    return technique
+def toy(tmp_path):
+    """The toy technique as a folder of its own, found by discovery: no other file is edited, nothing patched."""
+    with technique_folder(tmp_path, "toy", TOY_INIT, TOY_WGSL) as technique:
+        yield technique
 
 
 def test_a_new_technique_with_a_new_parameter_and_map_renders_and_probes(gpu, toy):

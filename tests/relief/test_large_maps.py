@@ -1,7 +1,8 @@
 """Large height maps on the distance techniques: the volume slots choose the most depth slices and sub-cells (up to
-the defaults) that fit the adapter's limits and maptools' (``maps.volume_plan``), say what they chose in one warning
-line, stay exact, and refuse before any work what does not fit even at the fewest slices, naming what the scene can
-change. Limits are faked here (a real 1K/2K bake takes minutes on a software adapter: docs/maps.md has those runs)."""
+the defaults) that fit the adapter's limits and maptools' (``maptools/volume/slot.py``'s ``volume_plan``), say what
+they chose in one warning line, stay exact, and refuse before any work what does not fit even at the fewest slices,
+naming what the scene can change. Limits are faked here (a real 1K/2K bake takes minutes on a software adapter:
+docs/maps.md has those runs)."""
 
 from __future__ import annotations
 
@@ -11,15 +12,17 @@ import cv2
 import numpy as np
 import pytest
 
-from maptools import distance as distance_kind
-from maptools import refined as refined_kind
+from maptools.kinds.distance import slot as distance_slot
+from maptools.kinds.distance_refined import cpu as refined_kind
+from maptools.kinds.distance_refined import slot as refined_slot
+from maptools.volume import cpu as distance_kind
+from maptools.volume import slot as volume_slot
+from maptools.volume.slot import DISTANCE_SLICES, DISTANCE_SUBCELLS, MIN_SLICES
 from tests.relief.scenes import material_scene
 from tests.relief.test_resource_limits import no_builtins, one_line, other_gpu  # noqa: F401 - a fixture
 from wgpuviewer import cli, textures
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.relief import maps
 from wgpuviewer.relief.accuracy import random_rays
-from wgpuviewer.relief.maps import DISTANCE_SLICES, DISTANCE_SUBCELLS, MIN_SLICES, volume_plan
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
 from wgpuviewer.relief.renderer import Renderer
@@ -27,6 +30,12 @@ from wgpuviewer.scene import parse_scene
 from wgpuviewer.textures import builtin_height
 
 VOLUMES = 33  # the refined map's 4 x 8 bins and the plain volume
+PLANS = {"distance": distance_slot.plan, "distance_refined": refined_slot.plan}
+
+
+def volume_plan(gpu, kind: str, w: int, h: int):
+    """The plan of the ``kind`` slot."""
+    return PLANS[kind](gpu, w, h)
 #: WebGPU's default limits: what every adapter offers at least.
 WEBGPU_DEFAULTS = {"max-texture-dimension-3d": 2048, "max-buffer-size": 1 << 28,
                    "max-storage-buffer-binding-size": 1 << 27}
@@ -127,8 +136,8 @@ def test_a_reduced_map_is_said_in_one_line_and_renders(gpu, caplog):
 def test_the_fewest_slices_and_sub_cells_stay_exact(gpu, monkeypatch, technique):
     """A map reduced to MIN_SLICES and 1x1 sub-cells is still safe: the tracer finds the float32-exact first hit
     (as test_techniques.py asks of the defaults), never one behind it."""
-    monkeypatch.setattr(maps, "DISTANCE_SLICES", MIN_SLICES)
-    monkeypatch.setattr(maps, "DISTANCE_SUBCELLS", 1)
+    monkeypatch.setattr(volume_slot, "DISTANCE_SLICES", MIN_SLICES)
+    monkeypatch.setattr(volume_slot, "DISTANCE_SUBCELLS", 1)
     h = builtin_height("bricks", (40, 48))
     for angle in (0, 45, 80):
         uv, view = random_rays(384, angle, seed=angle)

@@ -99,7 +99,7 @@ def test_the_window_depth_view_shows_the_offscreen_camera_depth(gpu):
     other modes do not pay its derivatives) paints 1 / (1 + camera depth) of the offscreen render's hits."""
     import wgpu
 
-    from wgpuviewer.relief.renderer import DEPTH_FORMAT, _read_texture
+    from wgpuviewer.relief.targets import DEPTH_FORMAT, read_texture
 
     text = plane_scene("pom", "layers = 64", position=CAMERA, height_scale=HEIGHT_SCALE, map_size=32)
     renderer = Renderer(parse_scene(text), gpu)
@@ -112,7 +112,7 @@ def test_the_window_depth_view_shows_the_offscreen_camera_depth(gpu):
     renderer.encode(encoder, [target.create_view()], depth.create_view(), ("rgba32float",), renderer.config("pom"),
                     renderer.scene.camera, SIZE, "depth")
     device.queue.submit([encoder.finish()])
-    shown = _read_texture(device, target, 4, np.float32)[..., 0]
+    shown = read_texture(device, target, 4, np.float32)[..., 0]
     covered = image.covered
     assert covered.mean() > 0.3
     expected = 1.0 / (1.0 + mode_data(image, "depth"))

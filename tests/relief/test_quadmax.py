@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from maptools.cache import cached_generate
-from maptools.cpu import level_sizes
+from maptools.kinds.maxmip.cpu import level_sizes
+from maptools.kinds.maxmip.slot import LEAF_SCALE, cell_max_height, pack_leaves, quadmax_atlas
 from tests.maptools.helpers import adversarial_maps
 from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
-from wgpuviewer.relief.maps import LEAF_SCALE, cell_max_height, pack_leaves, quadmax_atlas
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
 from wgpuviewer.textures import builtin_height

@@ -1,4 +1,4 @@
-"""The `quadmax_pom` hybrid (wgsl/techniques/quadmax_pom.wgsl): quadmax's walk cut after skip_steps steps, then POM
+"""The `quadmax_pom` hybrid (wgpuviewer/techniques/quadmax_pom/): quadmax's walk cut after skip_steps steps, then POM
 from the last point the walk proved free. Declared approximate; its error is measured here and in docs/techniques.md."""
 
 from __future__ import annotations
@@ -10,7 +10,8 @@ from tests.relief.twins import pom_from
 from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
 from wgpuviewer.relief.maps import depth_range
 from wgpuviewer.relief.probe import probe
-from wgpuviewer.techniques import AUTO_CANDIDATES, TECHNIQUES
+from wgpuviewer.techniques import TECHNIQUES
+from wgpuviewer.techniques.auto.autotable import AUTO_CANDIDATES
 from wgpuviewer.textures import builtin_height
 
 S = 0.05

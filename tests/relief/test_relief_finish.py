@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 
 from tests.relief.twins import relief_from
+from wgpuviewer.core.params import resolve_params
 from wgpuviewer.relief.accuracy import DEFAULT_ANGLES, random_rays
 from wgpuviewer.relief.maps import depth_range
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
-from wgpuviewer.techniques import TECHNIQUES, resolve_params
+from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.textures import builtin_height
 
 #: The accuracy suite's height maps (docs/accuracy.md).

@@ -1,35 +1,33 @@
 """The ray-search techniques pom_adaptive, relief, maxmip, distance and distance_refined, and the registry's view
-scales and layer-search ranges: what each one promises, measured with the GPU probe against the float64 reference."""
+scales and layer-search ranges: what each one promises, measured with the GPU probe against the float64 reference.
+The registry itself: one folder per technique, found without a list, in its order."""
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from PIL import Image
 
 from maptools.cache import cached_generate
-from maptools.cpu import level_sizes
+from maptools.kinds.distance_refined.slot import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
+from maptools.kinds.maxmip.cpu import level_sizes
+from maptools.kinds.maxmip.slot import cell_max_height, maxmip_atlas
 from tests.relief.scenes import material_scene
 from tests.relief.twins import pom_from
+from wgpuviewer.core.params import Fixed
 from wgpuviewer.relief.accuracy import measure, npot_height, random_rays
-from wgpuviewer.relief.maps import DEPTH_RANGE_SLACK, cell_max_height, depth_range, maxmip_atlas
+from wgpuviewer.relief.maps import DEPTH_RANGE_SLACK, depth_range
 from wgpuviewer.relief.output import OUTPUT_MODES, mode_data, mode_picture
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.relief.shaders import pack_trace_params, trace_params
 from wgpuviewer.scene import default_scene_path, load_scene, parse_scene
-from wgpuviewer.techniques import (
-    HANDOVER_STEPS,
-    PYRAMID_STEPS,
-    REFINED_BANDS,
-    REFINED_MAX_ANGLE,
-    REFINED_SECTORS,
-    TECHNIQUES,
-    Fixed,
-)
+from wgpuviewer.techniques import TECHNIQUES
+from wgpuviewer.techniques.shared import HANDOVER_STEPS, PYRAMID_STEPS
 from wgpuviewer.textures import builtin_height
 
 REAL = ("bricks", "bumps", "ridges")
@@ -220,7 +218,7 @@ def test_distance_refined_uses_the_same_tracer():
     """One tracer, two textures: the plain map is one volume every ray reads; the refined map's bins and the plain
     volume after them, described by the fixed TraceParams the tracer picks a ray's volume with."""
     plain, refined = TECHNIQUES["distance"], TECHNIQUES["distance_refined"]
-    assert plain.wgsl_file == refined.wgsl_file == "techniques/distance.wgsl"
+    assert plain.wgsl_file == refined.wgsl_file == str(Path(plain.folder) / "distance.wgsl")
     assert plain.params == refined.params
     p, r = plain.fixed_values(), refined.fixed_values()
     finish = {"handover_steps": HANDOVER_STEPS, "pyramid_steps": PYRAMID_STEPS}  # the grazing finish
@@ -290,7 +288,7 @@ def _cost_scale_by_parameter_names(params: dict) -> float:
 
 def _layer_range_by_parameter_names(params: dict) -> tuple[float, float]:
     """The layers view's range as it was once inferred from parameter names (frozen, as above)."""
-    from wgpuviewer.techniques import AUTO_CANDIDATES
+    from wgpuviewer.techniques.auto.autotable import AUTO_CANDIDATES
 
     if "max_error" in params:
         return 1.0, float(len(AUTO_CANDIDATES))
@@ -302,7 +300,7 @@ def _layer_range_by_parameter_names(params: dict) -> tuple[float, float]:
 def test_cost_and_layer_views_keep_their_scales():
     """Each entry's own cost_scale and layer_range give what the parameter names once gave, for its defaults,
     contract parameters and accuracy settings."""
-    from wgpuviewer.techniques import resolve_params
+    from wgpuviewer.core.params import resolve_params
 
     for t in TECHNIQUES.values():
         for overrides in ({}, *t.contract_params, *t.accuracy_settings):
@@ -425,3 +423,26 @@ def test_markdown_table_has_a_row_per_technique():
         assert [c.split("`")[1] for c in params.split(", ")] == [p.name for p in t.params] if t.params else params == "—"
     assert "`layers` 16 (1 to 1024)" in rows[list(TECHNIQUES).index("pom")]
     assert "`offset_limiting` (off)" in rows[list(TECHNIQUES).index("parallax")]
+
+
+# --- the registry: one folder per technique, found without a list ------------------------------------------
+
+#: The registry's order (the viewer's keys, the README table, the benchmark's rows).
+ORDER = ("basic", "normal", "parallax", "steep", "pom", "pom_adaptive", "relief", "maxmip", "distance",
+         "distance_refined", "quadmax", "quadmax_pom", "auto", "cone")
+
+
+def test_every_technique_is_its_folder_in_order():
+    """Each entry comes from wgpuviewer/techniques/NAME/ (its TECHNIQUE, its folder filled in), its WGSL file is in
+    its folder (distance_refined's is distance's), and the registry is read-only."""
+    import wgpuviewer.techniques as registry
+
+    assert tuple(TECHNIQUES) == ORDER
+    package = Path(registry.__file__).parent
+    folders = sorted(p.name for p in package.iterdir() if (p / "__init__.py").is_file())
+    assert folders == sorted(ORDER)
+    for name, t in TECHNIQUES.items():
+        assert t.folder == str(package / name) and Path(t.wgsl_file).is_file()
+        assert Path(t.wgsl_file).parent == (package / ("distance" if name == "distance_refined" else name))
+    with pytest.raises(TypeError):
+        TECHNIQUES["pom"] = TECHNIQUES["steep"]

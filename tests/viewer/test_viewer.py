@@ -14,6 +14,8 @@ import cv2
 import numpy as np
 import pytest
 
+from wgpuviewer.techniques import TECHNIQUES
+
 # Log records go to stderr as "LEVEL name: message", so ERRORs from wgpu/rendercanvas are visible.
 RUNNER = (
     "import logging, sys; logging.basicConfig(level=logging.WARNING, format='%(levelname)s %(name)s: %(message)s');"
@@ -146,12 +148,13 @@ BROKEN_RELOAD = """
 import sys
 from wgpuviewer.core import wgsl
 from wgpuviewer.scene import default_scene_path, load_scene
+from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.viewer.app import run_viewer
 
 good, reads = wgsl.read_wgsl, []
 
 def edited(name):  # pom.wgsl reads fine once (the first build), then is "edited" into an error
-    if name != "techniques/pom.wgsl":
+    if name != TECHNIQUES["pom"].wgsl_file:
         return good(name)
     reads.append(name)
     return good(name) + ("\\nfn oops() -> f32 { return 1.0 +; }\\n" if len(reads) > 1 else "")
@@ -169,7 +172,8 @@ def test_broken_shader_edit_keeps_the_window_drawing(display, adapter, tmp_path)
     result = subprocess.run([sys.executable, "-c", BROKEN_RELOAD, str(shot)], capture_output=True, text=True,
                             timeout=300, env=env)
     assert result.returncode == 0, result.stderr
-    lines = [line for line in result.stderr.splitlines() if line.startswith("shader error: techniques/pom.wgsl:")]
+    pom = TECHNIQUES["pom"].wgsl_file
+    lines = [line for line in result.stderr.splitlines() if line.startswith(f"shader error: {pom}:")]
     assert len(lines) == 1 and "expected" in lines[0], result.stderr
     image = cv2.imread(str(shot))
     assert image is not None and image.std() > 5

@@ -12,6 +12,7 @@ import wgpu
 from wgpuviewer.core import wgsl
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.scene import default_scene_path, load_scene
+from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.viewer.cameras import FlyCamera, OrbitCamera
 from wgpuviewer.viewer.shader_reload import ShaderReloader
 
@@ -75,7 +76,7 @@ def test_broken_shader_keeps_the_last_pipeline_and_reports_file_and_line(gpu, sc
     working = renderer._pipelines[key]
     reloader = ShaderReloader(renderer)
     good = wgsl.read_wgsl
-    pom = "techniques/pom.wgsl"
+    pom = TECHNIQUES["pom"].wgsl_file
     broken_text = good(pom) + "\nfn broken() -> f32 {\n    return 1.0 +;\n}\n"
     broken_line = broken_text.count("\n", 0, broken_text.index("return 1.0 +;")) + 1
     monkeypatch.setattr(wgsl, "read_wgsl", lambda name: broken_text if name == pom else good(name))
@@ -93,17 +94,19 @@ def test_broken_shader_keeps_the_last_pipeline_and_reports_file_and_line(gpu, sc
 
 
 def test_reloader_notices_edited_files(gpu, scene, tmp_path):
-    for name in ("common/trace.wgsl", "techniques/pom.wgsl"):
-        (tmp_path / name).parent.mkdir(exist_ok=True)
-        (tmp_path / name).write_text(wgsl.read_wgsl(name))
+    shared, folders = tmp_path / "wgsl", tmp_path / "techniques"  # wgsl/ and the technique folders
+    for root, name, source in ((shared, "common/trace.wgsl", "common/trace.wgsl"),
+                               (folders, "pom/pom.wgsl", TECHNIQUES["pom"].wgsl_file)):
+        (root / name).parent.mkdir(parents=True)
+        (root / name).write_text(wgsl.read_wgsl(source))
     renderer = Renderer(scene, gpu)
     renderer.render("steep", SIZE)
-    reloader = ShaderReloader(renderer, directory=tmp_path, interval=0.0)
+    reloader = ShaderReloader(renderer, directories=(shared, folders), interval=0.0)
     assert reloader.poll(1.0) == []
-    path = tmp_path / "techniques" / "pom.wgsl"
+    path = folders / "pom" / "pom.wgsl"
     stat = path.stat()
     os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns + 1_000_000))
-    assert reloader.poll(2.0) == ["techniques/pom.wgsl"]
+    assert reloader.poll(2.0) == ["pom/pom.wgsl"]
     assert reloader.errors == []  # the cached steep pipeline was rebuilt
     assert reloader.poll(3.0) == []
 
@@ -188,12 +191,12 @@ def test_gpu_timer_reads_back_pass_times_without_blocking(gpu, scene):
 
 
 def test_hud_lines_say_what_auto_chooses(gpu):
-    from wgpuviewer.techniques import AUTO_CANDIDATES
-    from wgpuviewer.viewer.hud import auto_lines
+    from wgpuviewer.techniques.auto.autotable import AUTO_CANDIDATES
+    from wgpuviewer.viewer.hud import panel_lines
 
     scene = load_scene(os.path.join(os.path.dirname(__file__), "..", "relief", "golden", "scene.toml"))
     renderer = Renderer(scene, gpu)
-    lines = auto_lines(renderer, 0.7)
+    lines = panel_lines(renderer, "auto", (("max_error", 0.7),))
     assert lines[0] == "auto at max_error 0.7: budget 0.5 texel"
     assert set(scene.materials) <= {line.rstrip(":") for line in lines}
     names = {name for name, _ in AUTO_CANDIDATES}

@@ -10,14 +10,14 @@
 
 An empty value is the same as an unset one; ``~`` in a path is the home folder. A bad value is a ``UserError``
 naming the variable, the value and the fix. Both CLIs check every variable before their command runs
-(``core.cli.run_command``), so no command accepts a value another refuses, whether or not it reaches the code that
+(``core.commands.run_command``), so no command accepts a value another refuses, whether or not it reaches the code that
 uses it. Variables of other systems (DISPLAY, WAYLAND_DISPLAY, XDG_*, APPDATA, OPENCV_*) are read where they are
 used, as those systems define them.
 
 Also what the GPU drivers read from the environment (``prepare_driver_environment``: a private
 ``$XDG_RUNTIME_DIR``), set by both CLIs and by the first adapter request of a library call.
 
-Standard library only: ``core.cli`` imports this before any GPU driver loads.
+Standard library only: ``core.commands`` imports this before any GPU driver loads.
 """
 
 from __future__ import annotations

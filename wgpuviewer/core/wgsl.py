@@ -37,7 +37,8 @@ def wgsl_dir() -> Path | None:
 
 
 def read_wgsl(name: str) -> str:
-    """Text of a WGSL file: ``name`` relative to ``wgsl/`` (e.g. "techniques/pom.wgsl"), or an absolute path."""
+    """Text of a WGSL file: ``name`` relative to ``wgsl/`` (e.g. "common/trace.wgsl"), or an absolute path (e.g. a
+    technique folder's file)."""
     path = Path(name)
     if path.is_absolute():
         return path.read_text(encoding="utf-8")

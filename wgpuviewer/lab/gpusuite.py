@@ -1,5 +1,6 @@
 """``./dev gpu-suite`` (``python -m wgpuviewer.lab.gpusuite``): the measurements a GPU machine is lent for, in one
-command within one time budget, and the README's headline from the newest run.
+command within one time budget; and the README's headline from the newest run (``headline_markdown``), which
+``wgpuviewer docs`` writes.
 
 It checks the adapter first (a software adapter is refused unless ``--allow-software``), then runs
 ``wgpuviewer bench``, ``filtering`` and ``perspective`` (``--suite full``; ``smoke`` and ``tiny`` are smaller) one
@@ -11,9 +12,10 @@ seconds, status (finished, stopped, failed, skipped), the rows it kept, its last
 bench writes its results view by view, so a stopped bench keeps the views it finished and its report is made from
 them; the studies write theirs at the end, so a stopped study keeps nothing but its record in the manifest.
 
-Last, the README's headline (between ``<!-- generated: headline -->`` and ``<!-- end generated -->``) is made
-again from the bench results of the newest run under the output root on a real GPU, else of the newest run on a
-software adapter, which it names as such; ``--headline-only`` does only that. Method: docs/benchmarks.md.
+A run writes nothing outside its folder: the README's headline (between ``<!-- generated: headline -->`` and
+``<!-- end generated -->``) is made from the bench results of the newest run under ``benchmarks/`` on a real GPU,
+else of the newest run on a software adapter, which it names as such, by ``wgpuviewer docs`` (``wgpuviewer.lab.docs``),
+which the run's last line asks for. Method: docs/benchmarks.md.
 
 May import anything of the project, like ``cli``: it starts the measuring commands as child processes and reads
 bench's results with bench's own table and headline rule.
@@ -37,7 +39,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from wgpuviewer.core.cli import OneLineParser, add_backend_option, command_line, prepare_process, run_command
+from wgpuviewer.core.commands import OneLineParser, add_backend_option, command_line, prepare_process, run_command
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import output_dir, write_bytes
 
@@ -60,14 +62,12 @@ SUITE_OPTIONS = {
     },
 }
 BUDGET_S = 480.0  # one 8-minute device call
-#: Kept back from the parts' boxes: a stopped part's unwinding, bench's report from the rows it kept, the README.
+#: Kept back from the parts' boxes: a stopped part's unwinding, bench's report from the rows it kept.
 RESERVE_S = 30.0
 #: How long a part may take to unwind after SIGTERM before it and what it started are killed.
 STOP_GRACE_S = 15.0
 MANIFEST = "manifest.json"
 OUTPUT_LINES = 40  # the last lines of a part's output (progress bars left out) the manifest keeps
-HEADLINE_BEGIN = "<!-- generated: headline -->"
-HEADLINE_END = "<!-- end generated -->"
 #: tqdm's progress line: "bench:  37%|███▋      | 1670/4500 [00:12<00:20, ...]".
 PROGRESS = re.compile(r"\|\s*(\d+)/(\d+) \[")
 
@@ -371,34 +371,19 @@ def headline_markdown(out_root: Path, readme_dir: Path) -> str:
     return "\n".join(lines)
 
 
-def replace_headline(text: str, body: str, readme: Path) -> str:
-    """``text`` with the part between ``HEADLINE_BEGIN`` and the next ``HEADLINE_END`` replaced by ``body``."""
-    if text.count(HEADLINE_BEGIN) != 1 or HEADLINE_END not in text.split(HEADLINE_BEGIN, 1)[1]:
-        raise UserError(f"--readme {readme}: needs one {HEADLINE_BEGIN!r} line followed by {HEADLINE_END!r}; add "
-                        "them where the headline goes")
-    before, after = text.split(HEADLINE_BEGIN, 1)
-    return f"{before}{HEADLINE_BEGIN}\n{body}\n{HEADLINE_END}{after.split(HEADLINE_END, 1)[1]}"
-
-
-def update_readme(readme: Path, out_root: Path) -> None:
-    text = readme.read_text(encoding="utf-8")
-    new = replace_headline(text, headline_markdown(out_root, readme.parent), readme)
-    if new != text:
-        write_bytes(readme, new.encode("utf-8"))
-
-
 # --- the command -----------------------------------------------------------------------------------------------
 
 
 def build_parser() -> OneLineParser:
     parser = OneLineParser(prog=PROG, description=(
         "bench, filtering and perspective within one time budget on this machine's GPU, into "
-        "OUT_ROOT/<adapter>/, then the README's headline from the newest run (docs/benchmarks.md)"))
+        "OUT_ROOT/<adapter>/; `wgpuviewer docs` then makes the README's headline from the newest run "
+        "(docs/benchmarks.md)"))
     parser.add_argument("--suite", choices=tuple(SUITE_OPTIONS), default="full",
                         help="full: the published measurement (default); smoke: the CI size; tiny: seconds, for "
                         "the test")
     parser.add_argument("--budget", type=float, default=BUDGET_S, metavar="SECONDS",
-                        help=f"the whole run's time, parts and README included (default {BUDGET_S:g}: one "
+                        help=f"the whole run's time, all parts included (default {BUDGET_S:g}: one "
                         "8-minute device call)")
     parser.add_argument("--box", action="append", default=[], metavar="PART=SECONDS",
                         help="a part's own time box (repeatable); the other parts share what the budget leaves "
@@ -408,12 +393,8 @@ def build_parser() -> OneLineParser:
     parser.add_argument("--allow-software", action="store_true",
                         help="run on a software adapter too (to test the command; its times are no GPU's)")
     parser.add_argument("--out-root", default=str(CHECKOUT / "benchmarks"),
-                        help="where the run's folder <adapter>/ goes, and the runs the headline is chosen from "
-                        "(default: the checkout's benchmarks/)")
-    parser.add_argument("--readme", default=str(CHECKOUT / "README.md"),
-                        help="the README whose headline section is made again (default: the checkout's)")
-    parser.add_argument("--headline-only", action="store_true",
-                        help="measure nothing: only make the README's headline again from the runs under --out-root")
+                        help="where the run's folder <adapter>/ goes (default: the checkout's benchmarks/, where "
+                        "`wgpuviewer docs` chooses the README's headline run from)")
     add_backend_option(parser)
     return parser
 
@@ -441,26 +422,10 @@ def checked_plan(args) -> Plan:
     return Plan(tuple(p for p in PARTS if p in parts), args.budget, fixed)
 
 
-def checked_readme(path: str) -> Path:
-    readme = Path(path)
-    try:
-        text = readme.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as error:
-        raise UserError(f"--readme {readme}: cannot be read ({getattr(error, 'strerror', None) or error}); give "
-                        "the checkout's README.md") from None
-    replace_headline(text, "", readme)  # the markers are there before any minute is spent measuring
-    return readme
-
-
 def command(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     plan = checked_plan(args)
-    readme = checked_readme(args.readme)
     out_root = output_dir(args.out_root, "--out-root")
-    if args.headline_only:
-        update_readme(readme, out_root)
-        print(readme)
-        return 0
     from wgpuviewer.core.gpu import choose_adapter, is_software
 
     adapter = choose_adapter(args.backend, quiet=True)
@@ -473,7 +438,8 @@ def command(argv: list[str]) -> int:
     prepare_run_folder(run_dir)
     print(f"{PROG}: {adapter.summary} -> {run_dir} ({args.suite} suite, {args.budget:g} s budget)", file=sys.stderr)
     manifest = run_suite(args, plan, run_dir, adapter.summary, software, command_line("./dev", [PROG, *argv]))
-    update_readme(readme, out_root)
+    print(f"{PROG}: README.md's headline is not written by a run: `wgpuviewer docs` makes it again from "
+          f"{CHECKOUT / 'benchmarks'}", file=sys.stderr)
     print(run_dir / MANIFEST)
     return 0 if all(p["status"] == "finished" for p in manifest["parts"]) else 1
 

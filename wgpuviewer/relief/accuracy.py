@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from wgpuviewer.core.errors import InputError
-from wgpuviewer.techniques import TECHNIQUES, get_technique, resolve_params
+from wgpuviewer.core.params import resolve_params
+from wgpuviewer.techniques import TECHNIQUES, get_technique
 
 from .probe import probe, shadow_probe
 from .reference import Hit, exact_hit, real_array, real_number, shadow, uv_error_texels, view_dir_from_angles
@@ -153,17 +154,24 @@ def npot_height(shape=(401, 343)) -> np.ndarray:
 
 
 @dataclass
-class Run:
+class Measured:
+    """What every run of measurements records: ``rays`` random rays per case, the ``seconds`` it took, and the
+    ``results`` by case (the key is the run's own)."""
+
+    rays: int
+    seconds: float
+    results: dict
+
+
+@dataclass
+class Run(Measured):
     """One accuracy run: every setting at every angle on every height map, the same random rays (seed 0) for every
-    setting of a (map, angle), each traced once by the float64 reference."""
+    setting of a (map, angle), each traced once by the float64 reference. ``results``: (height map, index in
+    settings, angle) -> the Accuracy."""
     heightmaps: dict[str, tuple[int, int]]  # name -> (rows, cols)
     angles: tuple[float, ...]
     settings: tuple[tuple[str, dict], ...]
     height_scale: float
-    rays: int
-    seconds: float
-    #: (height map, index in settings, angle) -> the measurement
-    results: dict[tuple[str, int, float], Accuracy]
 
 
 def run(heightmaps: dict, angles=DEFAULT_ANGLES, settings=DEFAULT_SETTINGS, height_scale=0.05, rays=4096,
@@ -186,8 +194,9 @@ def run(heightmaps: dict, angles=DEFAULT_ANGLES, settings=DEFAULT_SETTINGS, heig
                                                   backend)
                 if progress:
                     progress()
-    return Run({name: np.shape(h) for name, h in heightmaps.items()}, tuple(angles), tuple(settings),
-               height_scale, rays, time.perf_counter() - start, results)
+    return Run(rays=rays, seconds=time.perf_counter() - start, results=results,
+               heightmaps={name: np.shape(h) for name, h in heightmaps.items()}, angles=tuple(angles),
+               settings=tuple(settings), height_scale=height_scale)
 
 
 def _label(params: dict) -> str:
@@ -343,15 +352,12 @@ def measure_shadows(height: np.ndarray, techniques, elevations, uv, view, height
 
 
 @dataclass
-class ShadowRun:
-    """``shadow_run``'s measurements: (height map, technique, elevation) -> ShadowAccuracy."""
+class ShadowRun(Measured):
+    """``shadow_run``'s measurements: ``results``, (height map, technique, elevation) -> ShadowAccuracy."""
 
     techniques: tuple[str, ...]
     elevations: tuple[float, ...]
     view_angle: float
-    rays: int
-    seconds: float
-    results: dict[tuple[str, str, float], ShadowAccuracy]
 
 
 def shadow_run(heightmaps: dict, techniques=None, elevations=SHADOW_ELEVATIONS, height_scale=0.05, rays=4096,
@@ -365,7 +371,8 @@ def shadow_run(heightmaps: dict, techniques=None, elevations=SHADOW_ELEVATIONS, 
     for name, height in heightmaps.items():
         _, measured = measure_shadows(height, techniques, elevations, uv, view, height_scale, backend, progress)
         results.update({(name, m.technique, m.elevation): m for m in measured})
-    return ShadowRun(techniques, tuple(elevations), SHADOW_VIEW_ANGLE, rays, time.perf_counter() - start, results)
+    return ShadowRun(rays=rays, seconds=time.perf_counter() - start, results=results, techniques=techniques,
+                     elevations=tuple(elevations), view_angle=SHADOW_VIEW_ANGLE)
 
 
 def shadow_report(measured: ShadowRun) -> list[str]:

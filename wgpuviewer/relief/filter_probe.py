@@ -21,8 +21,9 @@ import wgpu
 from wgpuviewer.core.compute import Kernel, compute_for
 from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.core.gpu import Gpu, create_texture, get_gpu, mip_chain
+from wgpuviewer.core.params import resolve_params
 from wgpuviewer.core.structs import Struct
-from wgpuviewer.techniques import get_technique, resolve_params
+from wgpuviewer.techniques import get_technique
 
 from .filters import FILTER_GROUP, get_filter, pack_filter_params, resolve_filter_params, sampler_descriptor
 from .maps import binding

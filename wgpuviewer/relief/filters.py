@@ -16,9 +16,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.params import Param, Parametrized, resolve_params
 from wgpuviewer.core.structs import Struct, f32_literal, range_constants, scalar_uniform
 from wgpuviewer.core.wgsl import Generated
-from wgpuviewer.techniques import Param, Parametrized, resolve_params
 
 #: The default filter and derivative source: hardware trilinear on the unperturbed uv: the plain hardware lookup.
 DEFAULT_FILTER = "trilinear"

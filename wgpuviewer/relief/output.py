@@ -21,7 +21,7 @@ import numpy as np
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import atomic_open
 
-from .renderer import OffscreenImage
+from .targets import OffscreenImage
 
 #: What each output mode writes (the module docstring has the detail; `render --mode`'s help lists these).
 MODE_DESCRIPTIONS = {

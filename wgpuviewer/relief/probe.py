@@ -25,8 +25,9 @@ from maptools import validate_height
 from wgpuviewer.core.compute import Kernel, compute_for
 from wgpuviewer.core.errors import InputError
 from wgpuviewer.core.gpu import Gpu, get_gpu
+from wgpuviewer.core.params import resolve_params
 from wgpuviewer.core.structs import Struct
-from wgpuviewer.techniques import TECHNIQUES, get_technique, resolve_params
+from wgpuviewer.techniques import TECHNIQUES, get_technique
 
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range, layout_entries
 from .reference import real_array, real_number
@@ -255,8 +256,7 @@ def material_bind_group(gpu: Gpu, layout, tech, height: np.ndarray, height_scale
         usage=wgpu.BufferUsage.UNIFORM,
     )
     depth = 1.0 - height
-    maps = [(binding(n), MAP_SLOTS[n].build(gpu, depth, height_scale, f"probe:{n}",
-                                            *((probe,) if MAP_SLOTS[n].measured else ())))
+    maps = [(binding(n), MAP_SLOTS[n].build(gpu, depth, height_scale, f"probe:{n}"))
             for n in _derived(tech)]
     mode = wgpu.AddressMode.repeat if address == "repeat" else wgpu.AddressMode.clamp_to_edge
     sampler = device.create_sampler(

@@ -157,6 +157,24 @@ def cell_root(flat, rows: int, cols: int, cx, cy, x0, y0, ax, ay, t_enter, t_exi
     return np.where(np.isnan(s) & (t_exit >= 1.0), length, s)
 
 
+def _check_rays(depth, uv, view_dir, height_scale, address: str, max_cells):
+    """:func:`exact_hit`'s inputs checked: (depth, uv (N, 2), view_dir (N, 3), height_scale), the rays broadcast."""
+    d = _check_depth(depth)
+    check_address(address)
+    p = _as_rows(uv, 2, "uv")
+    v = _as_rows(view_dir, 3, "view_dir")
+    try:
+        n = np.broadcast_shapes((len(p),), (len(v),))[0]
+    except ValueError:
+        raise InputError(f"uv has {len(p)} rows but view_dir has {len(v)}") from None
+    scale = real_number(height_scale, "height_scale")
+    if not np.isfinite(scale) or scale < 0.0:
+        raise InputError(f"height_scale must be finite and >= 0, got {height_scale!r}")
+    if not real_number(max_cells, "max_cells") >= 1:
+        raise InputError(f"max_cells must be >= 1, got {max_cells!r}")
+    return d, np.broadcast_to(p, (n, 2)), np.broadcast_to(v, (n, 3)), scale
+
+
 def exact_hit(
     depth, uv, view_dir, height_scale, address: str = "repeat", max_cells: int = MAX_CELLS
 ) -> Hit:
@@ -179,22 +197,8 @@ def exact_hit(
     crosses more than ``max_cells`` cells (|floor x(1) - floor x(0)| + |same for y| + 1, decided
     before walking, independent of the map) is declined like V.z <= 0: ``valid = False``, NaN.
     """
-    d = _check_depth(depth)
-    check_address(address)
-    p = _as_rows(uv, 2, "uv")
-    v = _as_rows(view_dir, 3, "view_dir")
-    try:
-        n = np.broadcast_shapes((len(p),), (len(v),))[0]
-    except ValueError:
-        raise InputError(f"uv has {len(p)} rows but view_dir has {len(v)}") from None
-    p = np.broadcast_to(p, (n, 2))
-    v = np.broadcast_to(v, (n, 3))
-    scale = real_number(height_scale, "height_scale")
-    if not np.isfinite(scale) or scale < 0.0:
-        raise InputError(f"height_scale must be finite and >= 0, got {height_scale!r}")
-    if not real_number(max_cells, "max_cells") >= 1:
-        raise InputError(f"max_cells must be >= 1, got {max_cells!r}")
-
+    d, p, v, scale = _check_rays(depth, uv, view_dir, height_scale, address, max_cells)
+    n = len(p)
     rows, cols = d.shape
     flat = d.ravel()
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):

@@ -2,10 +2,10 @@
 
 A module = the generated interface (``interface``: the technique's ``TraceParams`` struct, its ``NAME_MIN`` /
 ``NAME_MAX`` parameter constants, ``MAX_LAYERS``, and the @group(1) binding lines of the uniform, the sampler and
-every texture slot it needs) + the technique's file (with what it includes from ``wgsl/common/``) + for rendering
-and the filter probe the texture filter (``filters.filter_interface`` and ``wgsl/filters/NAME.wgsl``, with a
-visibility snippet for the texel-loop filters) + for rendering a derivative source (``wgsl/derivatives/``) and a
-shading-normal snippet + an entry-point file (``entry/render.wgsl``, ``entry/probe.wgsl`` or
+every texture slot it needs) + the technique's file (``Technique.wgsl_file``, in its folder, with what it includes from
+``wgsl/common/``) + for rendering and the filter probe the texture filter (``filters.filter_interface`` and
+``wgsl/filters/NAME.wgsl``, with a visibility snippet for the texel-loop filters) + for rendering a derivative source
+(``wgsl/derivatives/``) and a shading-normal snippet + an entry-point file (``entry/render.wgsl``, ``entry/probe.wgsl`` or
 ``entry/filter_probe.wgsl``), composed by ``wgpuviewer.core.wgsl`` (includes, line map for error locations).
 Only the draw's filter and derivative source are compiled. A render module is also one material variant
 (``MaterialVariant``): its shadow snippet (``shadows/off|hard|soft.wgsl``: only a shadowing variant compiles

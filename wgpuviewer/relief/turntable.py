@@ -83,7 +83,7 @@ def turntable_pictures(renderer: Renderer, draw: DrawConfig, camera: Camera, siz
     """The (H, W, 3) uint8 pictures of ``mode`` along the orbit, rendered one at a time; ``progress(done, total)``
     after each."""
     for done, frame_camera in enumerate(orbit_cameras(camera, frames), 1):
-        yield mode_picture(renderer.render(draw, size, frame_camera, mode, size_name="--size"), mode)
+        yield mode_picture(renderer.render(draw, size, frame_camera, mode), mode)
         if progress is not None:
             progress(done, frames)
 

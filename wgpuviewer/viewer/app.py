@@ -29,7 +29,7 @@ import numpy as np
 import wgpu
 
 from wgpuviewer.camera import normalize
-from wgpuviewer.core.cli import terminal_progress
+from wgpuviewer.core.commands import terminal_progress
 from wgpuviewer.core.errors import InputError, UserError
 from wgpuviewer.core.gpu import get_gpu
 from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, FILTERS, get_filter

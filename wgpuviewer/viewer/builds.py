@@ -11,7 +11,7 @@ import sys
 import threading
 import time
 
-from wgpuviewer.core.cli import save_traceback
+from wgpuviewer.core.commands import save_traceback
 from wgpuviewer.core.errors import InputError, UserError
 
 

@@ -13,8 +13,9 @@ from wgpuviewer.scene import Camera
 LOOK_SPEED = 0.005  # radians per pixel dragged (default; settings.look_sensitivity)
 
 
-class FlyCamera:
-    """Position + yaw/pitch, started from (and reset to) the scene's camera."""
+class _SceneCamera:
+    """A camera started from (and reset to) the scene's camera ``start``, turned at ``sensitivity`` radians per
+    pixel dragged."""
 
     def __init__(self, camera: Camera, sensitivity: float = LOOK_SPEED):
         self.start = camera
@@ -22,11 +23,22 @@ class FlyCamera:
         self.reset()
 
     def reset(self):
-        c = self.start
-        self.position = np.asarray(c.position, np.float64)
-        forward = normalize(np.asarray(c.target, np.float64) - self.position)
+        raise NotImplementedError
+
+    @staticmethod
+    def pitch_of(direction: np.ndarray) -> float:
+        """The pitch of a unit direction: its angle above the horizontal plane."""
+        return float(np.arcsin(np.clip(direction[1], -1.0, 1.0)))
+
+
+class FlyCamera(_SceneCamera):
+    """Position + yaw/pitch, started from (and reset to) the scene's camera."""
+
+    def reset(self):
+        self.position = np.asarray(self.start.position, np.float64)
+        forward = normalize(np.asarray(self.start.target, np.float64) - self.position)
         self.yaw = float(np.arctan2(forward[0], -forward[2]))
-        self.pitch = float(np.arcsin(np.clip(forward[1], -1.0, 1.0)))
+        self.pitch = self.pitch_of(forward)
 
     @property
     def forward(self) -> np.ndarray:
@@ -47,25 +59,22 @@ class FlyCamera:
         return replace(self.start, position=tuple(p), target=tuple(p + self.forward), up=(0.0, 1.0, 0.0))
 
 
-class OrbitCamera:
+class OrbitCamera(_SceneCamera):
     """Orbits the scene camera's target: drag turns, the wheel zooms (distance factor per step)."""
 
     MIN_DISTANCE = 0.05
 
     def __init__(self, camera: Camera, sensitivity: float = LOOK_SPEED, zoom: float = 0.1):
-        self.start = camera
-        self.sensitivity = sensitivity
         self.zoom_step = zoom
-        self.reset()
+        super().__init__(camera, sensitivity)
 
     def reset(self):
-        c = self.start
-        self.target = np.asarray(c.target, np.float64)
-        offset = np.asarray(c.position, np.float64) - self.target
+        self.target = np.asarray(self.start.target, np.float64)
+        offset = np.asarray(self.start.position, np.float64) - self.target
         self.distance = max(float(np.linalg.norm(offset)), self.MIN_DISTANCE)
         d = offset / self.distance if np.linalg.norm(offset) > 0 else np.array([0.0, 0.0, 1.0])
         self.yaw = float(np.arctan2(d[0], d[2]))
-        self.pitch = float(np.arcsin(np.clip(d[1], -1.0, 1.0)))
+        self.pitch = self.pitch_of(d)
 
     def look(self, dx: float, dy: float):
         self.yaw -= dx * self.sensitivity

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from wgpuviewer.relief.renderer import DEPTH_FORMAT, DrawConfig, Renderer
+from wgpuviewer.relief.renderer import DrawConfig, Renderer
+from wgpuviewer.relief.targets import DEPTH_FORMAT
 from wgpuviewer.scene import Camera
 
 from . import error_view

@@ -24,7 +24,6 @@ from pathlib import Path
 import numpy as np
 
 from wgpuviewer.core.color import heat, linear_to_srgb
-from wgpuviewer.relief import autotable
 from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS, get_filter
 from wgpuviewer.relief.maps import height_scale_adjustable
 from wgpuviewer.techniques import get_technique
@@ -68,14 +67,10 @@ def summary_line(tag: str, summary, unit: str) -> str:
 
 
 @functools.lru_cache(maxsize=16)
-def auto_lines(renderer, max_error: float) -> list[str]:
-    """What auto chooses per view-angle range at ``max_error`` on each material of the renderer's scene (from its
-    measured table; the layers view, --mode layers, paints the candidate numbers)."""
-    lines = [f"auto at max_error {max_error:g}: budget {autotable.budgets()[autotable.budget_level(max_error)]:g} texel"]
-    for name in renderer.scene.materials:
-        lines.append(f"{name}:")
-        lines += [f"  {line}" for line in autotable.describe(renderer.auto_table(name), max_error)]
-    return lines
+def panel_lines(renderer, technique: str, params: tuple) -> list[str]:
+    """A technique's own lines on the renderer's scene (``Technique.panel_lines``; ``params``: its parameters as
+    sorted (name, value) pairs), e.g. what auto chooses per view-angle range on each material."""
+    return get_technique(technique).panel_lines(renderer.scene.materials, dict(params))
 
 
 class Hud:
@@ -305,35 +300,33 @@ class Hud:
         imgui.end()
 
     def _half(self, half, tag: str) -> None:
-        """One half's section: its technique's description and parameters, what auto picks, its filter."""
+        """One half's section: its technique's description, parameters and own lines (what auto picks), its filter."""
         v = self.viewer
         t = get_technique(half.technique)
         self._wrapped(GREY, t.description)
         self._params(t.name, tag)
-        if t.name == "auto":
-            for line in auto_lines(v.renderer, v.technique_params(t.name)["max_error"]):
+        if t.panel_lines is not None:
+            for line in panel_lines(v.renderer, t.name, tuple(sorted(v.technique_params(t.name).items()))):
                 imgui.text_colored(GREY, line)
         self._filter(half, tag)
 
     def _filter(self, half, tag: str) -> None:
         """The half's texture filter (a combo, F cycles it), its derivative source (Shift+F) and parameters."""
-        v = self.viewer
-        names = list(FILTERS)
-        changed, index = imgui.combo(f"filter (F)##{tag}", names.index(half.filter), names)
-        if changed:
-            half.filter = names[index]
-            v.state.mirror()
-        if imgui.is_item_hovered():
-            imgui.set_tooltip(get_filter(half.filter).description)
-        sources = list(DERIVATIVE_SOURCES)
-        changed, index = imgui.combo(f"derivatives (Shift+F)##{tag}", sources.index(half.derivatives), sources)
-        if changed:
-            half.derivatives = sources[index]
-            v.state.mirror()
-        if imgui.is_item_hovered():
-            imgui.set_tooltip(DERIVATIVE_SOURCES[half.derivatives].description)
+        self._choice(half, "filter", f"filter (F)##{tag}", FILTERS)
+        self._choice(half, "derivatives", f"derivatives (Shift+F)##{tag}", DERIVATIVE_SOURCES)
         f = get_filter(half.filter)
-        self._sliders(f.params, v.filter_params[f.name], f"{tag}:{f.name}")
+        self._sliders(f.params, self.viewer.filter_params[f.name], f"{tag}:{f.name}")
+
+    def _choice(self, half, attribute: str, label: str, registry: dict) -> None:
+        """A combo choosing the half's ``attribute`` among the names of ``registry`` (the other half follows where
+        it mirrors this one); hovered, the chosen entry's description."""
+        names = list(registry)
+        changed, index = imgui.combo(label, names.index(getattr(half, attribute)), names)
+        if changed:
+            setattr(half, attribute, names[index])
+            self.viewer.state.mirror()
+        if imgui.is_item_hovered():
+            imgui.set_tooltip(registry[getattr(half, attribute)].description)
 
     def _help_panel(self, flags, width, height) -> None:
         """The key list, opened in the room between the statistics and the info panel when they leave enough (else

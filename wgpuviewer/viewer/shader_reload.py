@@ -1,4 +1,5 @@
-"""Shader hot reload for the viewer: watch the WGSL files, rebuild the renderer's cached pipelines on change.
+"""Shader hot reload for the viewer: watch the WGSL files (``wgsl/`` and the technique folders), rebuild the
+renderer's cached pipelines on change.
 
 A compile error leaves the last working pipeline in use and is reported as ``file:line:column: message`` in the
 file that was edited (the composer's line map, ``wgpuviewer.core.wgsl.Module.locate``), for the HUD.
@@ -9,32 +10,37 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
+from wgpuviewer import techniques
 from wgpuviewer.core.wgsl import wgsl_dir
 
 
 class ShaderReloader:
-    """Polls the mtimes of the ``*.wgsl`` files under ``directory`` and rebuilds ``renderer``'s pipelines."""
+    """Polls the mtimes of the ``*.wgsl`` files under ``directories`` (default: ``wgsl/`` and the technique
+    folders' package) and rebuilds ``renderer``'s pipelines."""
 
-    def __init__(self, renderer, directory: Path | None = None, interval: float = 0.5):
+    def __init__(self, renderer, directories: tuple[Path, ...] | None = None, interval: float = 0.5):
         self.renderer = renderer
-        self.directory = directory if directory is not None else wgsl_dir()
+        if directories is None:
+            shared = wgsl_dir()  # None where the package's files are not plain files: nothing to watch there
+            directories = (*((shared,) if shared is not None else ()), *map(Path, techniques.__path__))
+        self.directories = directories
         self.interval = interval
         self.errors: list[str] = []
         self._next_check = 0.0
         self._mtimes = self._scan()
 
     def _scan(self) -> dict[str, float]:
-        if self.directory is None:
-            return {}
+        """mtime of every file, by its path relative to its directory (e.g. common/trace.wgsl, pom/pom.wgsl)."""
         out = {}
-        for path in self.directory.rglob("*.wgsl"):
-            with contextlib.suppress(OSError):
-                out[path.relative_to(self.directory).as_posix()] = path.stat().st_mtime_ns
+        for directory in self.directories:
+            for path in directory.rglob("*.wgsl"):
+                with contextlib.suppress(OSError):
+                    out[path.relative_to(directory).as_posix()] = path.stat().st_mtime_ns
         return out
 
     def poll(self, now: float) -> list[str]:
         """Check for edits at most every ``interval`` seconds; returns the changed file names."""
-        if now < self._next_check or self.directory is None:
+        if now < self._next_check or not self.directories:
             return []
         self._next_check = now + self.interval
         mtimes = self._scan()

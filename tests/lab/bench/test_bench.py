@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from tests.relief.technique_folder import technique_folder
 from wgpuviewer.lab.bench import report as bench_report
 from wgpuviewer.lab.bench import run as bench
 from wgpuviewer.lab.bench.plots import pareto_front
@@ -22,7 +23,7 @@ from wgpuviewer.lab.bench.view import (
 from wgpuviewer.relief.accuracy import simd_tile_cost
 from wgpuviewer.relief.reference import sample_bilinear
 from wgpuviewer.relief.renderer import DrawConfig, Renderer  # imports wgpu before the log fixture touches its logger
-from wgpuviewer.techniques import TECHNIQUES, Param, Technique
+from wgpuviewer.techniques import TECHNIQUES
 
 # --- sweeps come from the registry ---------------------------------------------------------------
 
@@ -34,14 +35,23 @@ def test_every_registered_technique_is_benchmarked_with_valid_params():
         assert set(params) == {p.name for p in TECHNIQUES[name].params}
 
 
-def test_unknown_technique_runs_its_defaults_and_stale_sweeps_are_skipped(monkeypatch):
-    new = Technique("brand_new", "x", "", "", ("albedo",), (Param("steps", 7, 1, 99, int, ""),), ray_search=True)
-    monkeypatch.setitem(TECHNIQUES, "brand_new", new)
-    assert bench.settings_for("brand_new", bench.SWEEPS) == [{"steps": 7}]
-    # a sweep naming a parameter the technique no longer has is dropped, not an error
-    sweeps = {"brand_new": ({"layers": 8}, {"steps": 9})}
-    assert bench.settings_for("brand_new", sweeps) == [{"steps": 9}]
-    assert bench.settings_for("brand_new", {"brand_new": ({"layers": 8},)}) == [{"steps": 7}]
+BRAND_NEW = '''"""A technique the benchmark has no sweep for."""
+
+from wgpuviewer.core.params import Param
+from wgpuviewer.techniques import Technique
+
+TECHNIQUE = Technique("brand_new", "x", "", "", ("albedo",), (Param("steps", 7, 1, 99, int, ""),), ray_search=True,
+                      order=1000)
+'''
+
+
+def test_unknown_technique_runs_its_defaults_and_stale_sweeps_are_skipped(tmp_path):
+    with technique_folder(tmp_path, "brand_new", BRAND_NEW):
+        assert bench.settings_for("brand_new", bench.SWEEPS) == [{"steps": 7}]
+        # a sweep naming a parameter the technique no longer has is dropped, not an error
+        sweeps = {"brand_new": ({"layers": 8}, {"steps": 9})}
+        assert bench.settings_for("brand_new", sweeps) == [{"steps": 9}]
+        assert bench.settings_for("brand_new", {"brand_new": ({"layers": 8},)}) == [{"steps": 7}]
 
 
 def test_table41_layer_counts_are_in_both_suites():
@@ -223,7 +233,7 @@ def test_batched_capture_is_the_renderers_render_and_a_round_is_one_submit(tmp_p
     """Draws of one technique with different parameters share a submit and keep their own parameters; the bench's
     fetch statistics come from exactly the data render() gives."""
     from wgpuviewer.lab.bench.capture import capture
-    from wgpuviewer.lab.bench.timing import time_configs
+    from wgpuviewer.lab.bench.config_timing import time_configs
 
     view = make_view(load_heightmap("bumps", 64, tmp_path), 60.0, (40, 24))
     renderer = Renderer(view.scene, gpu)

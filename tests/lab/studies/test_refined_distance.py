@@ -8,16 +8,19 @@ import numpy as np
 import pytest
 
 from maptools.cache import cached_generate
+from maptools.kinds.distance_refined.slot import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
+from maptools.volume.slot import DISTANCE_SLICES, uploaded_volume
 from wgpuviewer.lab.bench.run import REAL_MAPS
 from wgpuviewer.lab.studies.refined_distance import donnelly, formats, pits, reliefs
 from wgpuviewer.lab.studies.refined_distance.baseline import plain_before
-from wgpuviewer.lab.studies.refined_distance.run import CONDITION_PAIRS, PLAIN, SUITES, ratios, run, variants
+from wgpuviewer.lab.studies.refined_distance.report import ratios
+from wgpuviewer.lab.studies.refined_distance.run import SUITES, run
 from wgpuviewer.lab.studies.refined_distance.tracer import trace
+from wgpuviewer.lab.studies.refined_distance.variants import CONDITION_PAIRS, PLAIN, variants
 from wgpuviewer.relief.accuracy import random_rays
-from wgpuviewer.relief.maps import DISTANCE_SLICES, depth_range, uploaded_volume
+from wgpuviewer.relief.maps import depth_range
 from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit
-from wgpuviewer.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 from wgpuviewer.textures import BUILTINS, builtin_height
 
 
@@ -232,7 +235,7 @@ def test_the_condition_pairs_compare_a_map_with_itself_but_the_condition():
     """Each pair differs only in the visibility condition, "off" set explicitly; the renderer's technique sits on
     the product's bins with the kind's default."""
     from maptools.registry import get_kind
-    from wgpuviewer.lab.studies.refined_distance import run as study
+    from wgpuviewer.lab.studies.refined_distance import variants as study
 
     kind = get_kind("distance_refined")
     named = {v.name: v for v in variants()}
@@ -247,7 +250,7 @@ def test_the_condition_pairs_compare_a_map_with_itself_but_the_condition():
 def test_compact_storages_round_every_value_down():
     """float16 and 8-bit stored values are never above the float32 ones (a step never grows: safety holds), and
     lose at most one float16 step / one 8-bit step of the range (values above the 8-bit range are held at it)."""
-    from wgpuviewer.lab.studies.refined_distance.run import EIGHT_BIT_RANGE, STORAGES
+    from wgpuviewer.lab.studies.refined_distance.variants import EIGHT_BIT_RANGE, STORAGES
 
     rng = np.random.default_rng(5)
     v = np.concatenate([rng.random(5000) * 40.0, [0.0, EIGHT_BIT_RANGE, 1e-8, 60000.0]]).astype(np.float32)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from wgpuviewer.core.cli import comma_list, comma_numbers, parse_size
+from wgpuviewer.core.commands import comma_list, comma_numbers, parse_size
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.lab.harness.study import add_measurement_options
 

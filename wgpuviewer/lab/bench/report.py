@@ -245,6 +245,21 @@ def table41_section(values: list[dict], registry_has_adaptive: bool) -> list[str
 def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | None) -> str:
     from wgpuviewer.techniques import TECHNIQUES
 
+    lines = [*_preamble(values, meta), *headline_section(values, meta)]
+    lines += table41_section(values, "pom_adaptive" in TECHNIQUES)
+    lines += per_heightmap_section(values)
+    lines += memory_section(values) + correlation_section(values, meta) + run_section(meta)
+    lines += ["## Plots", ""]
+    if plot_note:
+        lines.append(plot_note)
+    for p in plots:
+        lines.append(f"![{p}]({p})")
+    lines.append("")
+    return "\n".join(lines)
+
+
+def _preamble(values: list[dict], meta: dict) -> list[str]:
+    """The header, the run's settings, what the adapter's times mean, and where the method is."""
     suite = meta["suite"]
     w, h = suite.resolution
     lines = [
@@ -274,8 +289,14 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
     lines += ["", "Method and definitions: docs/benchmarks.md. The angle is the view angle at the frame "
               "centre; it varies over the frame by up to about 1.5° (CSV: angle_min, angle_max). Rows with "
               "capped rays exclude them from the UV error; the capped fraction is listed beside it.", ""]
+    return lines
 
-    lines += ["## Headline: cheapest technique per error budget", "",
+
+def headline_section(values: list[dict], meta: dict) -> list[str]:
+    """The cheapest configuration per error budget, near winners, the winners against the reference
+    configuration, and the cheapest per angle."""
+    suite = meta["suite"]
+    lines = ["## Headline: cheapest technique per error budget", "",
               f"A configuration meets a budget when its p95 UV error is within it in every measurement up to "
               f"{HEADLINE_MAX_ANGLE:g}° (all height maps of this run); cost is the geometric mean of its time "
               "ratio to basic over those measurements.", "",
@@ -325,10 +346,12 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
             cells.append("none" if best is None else f"{config_label(best[0])} ({_f(best[1])}×)")
         lines.append(f"| ≤ {budget:g} | " + " | ".join(cells) + " |")
     lines.append("")
+    return lines
 
-    lines += table41_section(values, "pom_adaptive" in TECHNIQUES)
 
-    lines += ["## Per height map", "",
+def per_heightmap_section(values: list[dict]) -> list[str]:
+    """Per height map and configuration: time ratio, fetches, capped share, PSNR and the p95 error per angle."""
+    lines = ["## Per height map", "",
               "Time ratio to basic, fetches and SIMD-tile fetches: mean over the angles; then the p95 UV error (texels) "
               "per angle. "
               "All numbers per measurement are in results.csv.", ""]
@@ -351,15 +374,7 @@ def report(values: list[dict], meta: dict, plots: list[str], plot_note: str | No
                 f"{_f(float(np.nanmin([r['psnr_db'] for r in rows])), 1)} | "
                 + " | ".join(_f(per_angle[a]["uv_err_p95"]) if a in per_angle else "–" for a in m_angles) + " |")
         lines.append("")
-
-    lines += memory_section(values) + correlation_section(values, meta) + run_section(meta)
-    lines += ["## Plots", ""]
-    if plot_note:
-        lines.append(plot_note)
-    for p in plots:
-        lines.append(f"![{p}]({p})")
-    lines.append("")
-    return "\n".join(lines)
+    return lines
 
 
 # --- map memory, cost model, the run ---------------------------------------------------------------

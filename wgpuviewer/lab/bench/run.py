@@ -28,10 +28,11 @@ from pathlib import Path
 import numpy as np
 
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.params import resolve_params
 from wgpuviewer.lab.harness import suite as harness_suite
 from wgpuviewer.lab.harness.header import Clock, Header
 from wgpuviewer.lab.harness.table import Column, Table
-from wgpuviewer.techniques import TECHNIQUES, resolve_params
+from wgpuviewer.techniques import TECHNIQUES
 
 #: Parameter settings per technique name (overrides of the registry defaults). Settings naming a
 #: parameter the technique does not have are skipped; a technique not listed runs its defaults.
@@ -298,11 +299,9 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     from tqdm import tqdm
 
     from wgpuviewer.core.gpu import get_gpu
-    from wgpuviewer.relief.renderer import DrawConfig, Renderer
+    from wgpuviewer.relief.renderer import DrawConfig
 
-    from .capture import capture
-    from .timing import time_configs
-    from .view import load_heightmap, make_view, reference_pool
+    from .view import reference_pool
 
     suite = options.suite
     gpu = get_gpu(options.backend, quiet=True)
@@ -312,7 +311,6 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     draws = [DrawConfig.of(name, params) for name, params in configs]
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    size = suite.resolution
     rows: list[Row] = []
     busy = []
     counters = {"submits": 0, "readbacks": 0}
@@ -323,24 +321,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
             tqdm(total=total, desc="bench", unit="row", file=sys.stderr, disable=not progress) as bar:
         # (1) height maps, views and every map the configurations sample
         phase_start = time.perf_counter()
-        work = []  # (heightmap, views, the renderer whose maps and pipelines its views share, map bytes per technique)
-        for map_name in suite.heightmaps:
-            try:
-                heightmap = load_heightmap(map_name, suite.builtin_size, Path(workdir), suite.real_size)
-            except Exception as e:  # noqa: BLE001 - e.g. scikit-image's data not loadable offline
-                options.notes.append(f"height map {map_name!r} left out: {type(e).__name__}: {e}")
-                bar.update(len(suite.angles) * len(configs))
-                continue
-            views = []
-            for angle in suite.angles:
-                try:
-                    views.append(make_view(heightmap, angle, size))
-                except ValueError as e:
-                    raise UserError(f"--angles {angle:g}: {e}") from None
-            bar.set_postfix_str(f"{map_name}: maps")
-            first = Renderer(views[0].scene, gpu)  # the views of this map share its maps and pipelines
-            sizes = {name: map_bytes(first, "relief", name) for name in dict.fromkeys(n for n, _ in configs)}
-            work.append((heightmap, views, first, sizes))
+        work = _prepare(suite, configs, gpu, Path(workdir), options.notes, bar)
         phases["maps"] = time.perf_counter() - phase_start
         # (2) reference hits, all views at once (a pool works on them while the GPU part runs)
         phase_start = time.perf_counter()
@@ -360,15 +341,8 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
             for index, (heightmap, views, first, sizes) in enumerate(work):
                 for view in views:
                     bar.set_postfix_str(f"{heightmap.name} {view.angle:g}°")
-                    # (3) the GPU part of this view
-                    gpu_clock = time.perf_counter()
-                    renderer = Renderer(view.scene, gpu, like=first)
-                    timing = time_configs(renderer, configs, size, suite.frames, suite.warmup)
-                    data = capture(renderer, draws, size)
-                    gpu_s += time.perf_counter() - gpu_clock
-                    counters["submits"] += timing.submits + data.submits
-                    counters["readbacks"] += timing.readbacks + data.readbacks
-                    busy.append(timing.busy_fraction)
+                    timing, data, seconds = _gpu_part(view, gpu, first, configs, draws, suite, counters, busy)
+                    gpu_s += seconds
                     collect(block=len(processing) >= 2)  # at most two views' data waiting
                     processing.append(worker.submit(_view_rows, suite, heightmap, view, configs, timing,
                                                     data.captures, sizes, pending.pop(0), (adapter, backend)))
@@ -379,8 +353,7 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     meta = {
         "header": clock.header(TITLE.format(suite=suite.name), options.command, adapter, suite.name),
         "suite": suite, "adapter": adapter, "backend": backend, "software": gpu.software,
-        "timer": rows[0].values["timer"] if rows else "",
-        "notes": options.notes, "configs": configs,
+        "timer": rows[0].values["timer"] if rows else "", "notes": options.notes, "configs": configs,
         "techniques": options.techniques, "busy_max": max(busy) if busy else float("nan"),
         "python": platform.python_version(), "platform": platform.platform(),
         "phases": phases, "counters": {**counters, "views": sum(len(w[1]) for w in work)},
@@ -388,6 +361,57 @@ def run(options: Options, out: Path, progress: bool = True) -> list[dict]:
     TABLE.write(out / "results.csv", [r.values for r in rows])
     write_outputs(out, rows, meta)
     return [r.values for r in rows]
+
+
+def _gpu_part(view, gpu, first, configs: list, draws: list, suite: Suite, counters: dict, busy: list) -> tuple:
+    """Phase (3) of ``run`` for one view: timing (one submit per round of frames), then every configuration's trace
+    data in batches; (timing, data, the seconds they took), the submit and read-back counters and the busy
+    fractions updated."""
+    import time
+
+    from wgpuviewer.relief.renderer import Renderer
+
+    from .capture import capture
+    from .config_timing import time_configs
+
+    gpu_clock = time.perf_counter()
+    renderer = Renderer(view.scene, gpu, like=first)
+    timing = time_configs(renderer, configs, suite.resolution, suite.frames, suite.warmup)
+    data = capture(renderer, draws, suite.resolution)
+    seconds = time.perf_counter() - gpu_clock
+    counters["submits"] += timing.submits + data.submits
+    counters["readbacks"] += timing.readbacks + data.readbacks
+    busy.append(timing.busy_fraction)
+    return timing, data, seconds
+
+
+def _prepare(suite: Suite, configs: list, gpu, workdir: Path, notes: list[str], bar) -> list[tuple]:
+    """Phase (1) of ``run``: per height map (a map that cannot be loaded is left out with a note), its views and a
+    renderer with every map the configurations sample built, whose maps and pipelines the views share; (heightmap,
+    views, that renderer, map bytes per technique) each."""
+    from wgpuviewer.relief.renderer import Renderer
+
+    from .view import load_heightmap, make_view
+
+    work = []
+    for map_name in suite.heightmaps:
+        try:
+            heightmap = load_heightmap(map_name, suite.builtin_size, workdir, suite.real_size)
+        except Exception as e:  # noqa: BLE001 - e.g. scikit-image's data not loadable offline
+            notes.append(f"height map {map_name!r} left out: {type(e).__name__}: {e}")
+            bar.update(len(suite.angles) * len(configs))
+            continue
+        views = []
+        for angle in suite.angles:
+            try:
+                views.append(make_view(heightmap, angle, suite.resolution))
+            except ValueError as e:
+                raise UserError(f"--angles {angle:g}: {e}") from None
+        bar.set_postfix_str(f"{map_name}: maps")
+        first = Renderer(views[0].scene, gpu)  # the views of this map share its maps and pipelines
+        sizes = {name: map_bytes(first, "relief", name) for name in dict.fromkeys(n for n, _ in configs)}
+        work.append((heightmap, views, first, sizes))
+    return work
 
 
 def write_outputs(out: Path, rows: list[Row], meta: dict) -> None:

@@ -1,9 +1,11 @@
 """A study as a ``wgpuviewer`` subcommand: the ``Study`` protocol every study folder exposes as ``STUDY`` (in its
 ``__init__``), its discovery (every package under ``wgpuviewer.lab.studies``), its registration on the command line
-with the options every measuring command shares (the CLI puts the command line, ``core.cli.command_line``, on
+with the options every measuring command shares (the CLI puts the command line, ``core.commands.command_line``, on
 ``args.command_line`` for the report's header), and ``run_study``, the one order every measuring command runs in:
 every option value checked, then the output folder checked and created and the stale temps of a killed earlier
-run swept from it, then the measurement (the GPU starts only there).
+run swept from it, then the measurement (the GPU starts only there). ``StudyCommand`` is the common form of a
+study's ``STUDY`` (its name, help and suite help; its own options; ``run`` calling the folder's ``run.run``), and
+``numbers_within`` checks a comma-separated option of numbers against a range.
 
 A study's ``__init__`` stays light (no GPU, no heavy imports): the command line imports every study to build
 its parser; ``options`` and ``run`` import the measuring code when the command runs.
@@ -18,7 +20,7 @@ import pkgutil
 from pathlib import Path
 from typing import Protocol, runtime_checkable
 
-from wgpuviewer.core.cli import add_backend_option
+from wgpuviewer.core.commands import add_backend_option
 from wgpuviewer.core.io import output_dir, remove_abandoned_temps
 
 from .suite import NAMES
@@ -81,3 +83,48 @@ def add_measurement_options(parser, out_help: str, suite_help: str) -> None:
     parser.add_argument("--suite", choices=NAMES, default="full", help=f"{suite_help} (default %(default)s)")
     add_backend_option(parser)
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def numbers_within(text: str | None, option: str, example: str, low: float, high: float, what: str = "degrees",
+                   above_low: bool = False) -> list[float] | None:
+    """A comma-separated option of numbers (``core.commands.comma_numbers``), each from ``low`` (or above it) to ``high``;
+    else a UserError naming the option and the range."""
+    from wgpuviewer.core.commands import comma_numbers
+    from wgpuviewer.core.errors import UserError
+
+    values = comma_numbers(text, option, example)
+    if values is not None and not all((low < v if above_low else low <= v) and v <= high for v in values):
+        span = f"above {low:g} and at most {high:g}" if above_low else f"from {low:g} to {high:g}"
+        raise UserError(f"{option} {text!r}: expected {what} {span}")
+    return values
+
+
+class StudyCommand:
+    """A study's command whose ``run`` module's ``run(out=OUT, **options)`` writes report.md: ``--out``, ``--suite``,
+    ``--backend`` and ``--quiet`` (``add_measurement_options``) plus the study's own options (``add_options``), each
+    checked by ``options`` (the shared ones by ``shared_options``)."""
+
+    def __init__(self, name: str, help: str, out_help: str, suite_help: str):
+        self.name, self.help, self.out_help, self.suite_help = name, help, out_help, suite_help
+
+    def add_arguments(self, parser: argparse.ArgumentParser) -> None:
+        add_measurement_options(parser, self.out_help, self.suite_help)
+        self.add_options(parser)
+
+    def add_options(self, parser: argparse.ArgumentParser) -> None:
+        """The study's own options (none by default)."""
+
+    @staticmethod
+    def shared_options(args: argparse.Namespace) -> dict:
+        """``run``'s keyword arguments from the options every measuring command has."""
+        return {"suite_name": args.suite, "backend": args.backend, "progress": not args.quiet,
+                "command": args.command_line}
+
+    def options(self, args: argparse.Namespace) -> dict:
+        return self.shared_options(args)
+
+    def run(self, options: dict, out: Path) -> int:
+        study = importlib.import_module(f"{type(self).__module__.rpartition('.')[0]}.run")
+        study.run(out=out, **options)
+        print(out / "report.md")
+        return 0

@@ -64,6 +64,12 @@ class Column:
         return text
 
 
+
+def columns(type_: type, unit: str, *names: str) -> tuple[Column, ...]:
+    """Columns ``names`` of one type and unit, in that order."""
+    return tuple(Column(name, type_, unit) for name in names)
+
+
 class Table:
     """The columns of one kind of results file (``what`` names it in error messages, e.g. "benchmark results")."""
 

@@ -11,7 +11,9 @@ import pytest
 
 from wgpuviewer.cli import main
 from wgpuviewer.lab.studies.filtering import supersample as ss
-from wgpuviewer.lab.studies.filtering.report import DOCS_BEGIN, DOCS_END, docs_block_of, place_labels, rereport
+from wgpuviewer.lab.studies.filtering.docs import DOCS_BEGIN, DOCS_END, docs_block_of
+from wgpuviewer.lab.studies.filtering.pictures import place_labels
+from wgpuviewer.lab.studies.filtering.report import rereport
 from wgpuviewer.lab.studies.filtering.run import flicker_psnr, flicker_ratio, psnr, psnr_uncertainty, unresolved, void_reason
 from wgpuviewer.lab.studies.filtering.suites import (
     EXPLICIT_GRADIENTS,

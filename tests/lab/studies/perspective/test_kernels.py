@@ -14,6 +14,8 @@ from wgpuviewer.lab.studies.perspective.kernels import PARAMS, SPAN, kernels_for
 from wgpuviewer.lab.studies.perspective.run import ulp_difference
 from wgpuviewer.relief.renderer import Renderer  # noqa: F401 - imports wgpu before the log fixture touches its logger
 
+from .cases import hard_cases
+
 pytestmark = pytest.mark.requires_gpu
 
 #: Vulkan lets hardware round a division to 2.5 ulp and fuse a * b + c; lavapipe does neither (measured: 0 ulp).
@@ -21,16 +23,7 @@ HARDWARE_ULP = 4
 
 
 def _cases():
-    rng = np.random.default_rng(7)
-    wide = g.build(g.Setup(span_length=2000, rows=24, tilt=80.0, offset=1e6))
-    yield "1e6 offset, random spans", wide, g.Spans(rng.integers(0, 1000, 6), rng.integers(0, 24, 6), 777)
-    grazing = g.build(g.Setup(span_length=343, rows=5, tilt=89.9))
-    yield "89.9 degrees, NPOT", grazing, grazing.spans
-    crossing = g.build(g.Setup(span_length=401, rows=3, tilt=95.0))
-    yield "past the horizon", crossing, crossing.spans
-    for length in (1, 2, 63):
-        short = g.build(g.Setup(span_length=length, rows=2, tilt=60.0))
-        yield f"{length}-pixel spans", short, short.spans
+    yield from hard_cases(7, random_spans=6, grazing_rows=5)
     # spans shorter than parallel_32's threads, more of them than one workgroup holds at 32 threads a span
     tile = g.build(g.Setup(span_length=16, rows=9, tilt=80.0))
     yield "9 spans of 16 pixels", tile, tile.spans

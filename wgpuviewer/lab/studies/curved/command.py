@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from wgpuviewer.core.cli import comma_list, comma_numbers
+from wgpuviewer.core.commands import comma_list
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.lab.harness.study import add_measurement_options
+from wgpuviewer.lab.harness.study import StudyCommand, numbers_within
 
 #: The largest S/R: beyond it the relief is as deep as a good part of the radius and "displaced surface" loses
 #: its sense (at S/R = 1 the floor is the centre).
@@ -14,16 +12,8 @@ MAX_RATIO = 0.5
 MAX_RAYS = 65536
 
 
-class Curved:
-    name = "curved"
-    help = ("the tangent-plane trace against the exact hit on a sphere or cylinder of radius R, float64, as a "
-            "function of S/R and the view angle, and techniques against the same truth (results.csv, report.md, "
-            "plots)")
-
-    def add_arguments(self, parser) -> None:
-        add_measurement_options(parser, "output folder (results.csv, report.md, *.png)",
-                                "smoke: one small map, two angles, two S/R, pom (seconds); full: real and hard maps "
-                                "at 128x128, 0-85 degrees, S/R 1e-3 to 0.2, sphere and cylinder, pom and maxmip")
+class Curved(StudyCommand):
+    def add_options(self, parser) -> None:
         parser.add_argument("--heightmaps", help="comma-separated: builtins and/or scikit-image brick,grass,gravel")
         parser.add_argument("--angles", help="comma-separated view angles to the normal, degrees (0 to 85)")
         parser.add_argument("--ratios", help=f"comma-separated S/R, height scale over radius (above 0, at most "
@@ -39,12 +29,8 @@ class Curved:
 
         from .geometry import SURFACES
 
-        angles = comma_numbers(args.angles, "--angles", "30,80")
-        if angles is not None and not all(0.0 <= a <= 85.0 for a in angles):
-            raise UserError(f"--angles {args.angles!r}: expected degrees from 0 to 85")
-        ratios = comma_numbers(args.ratios, "--ratios", "0.001,0.01,0.1")
-        if ratios is not None and not all(0.0 < r <= MAX_RATIO for r in ratios):
-            raise UserError(f"--ratios {args.ratios!r}: expected S/R above 0 and at most {MAX_RATIO:g}")
+        angles = numbers_within(args.angles, "--angles", "30,80", 0.0, 85.0)
+        ratios = numbers_within(args.ratios, "--ratios", "0.001,0.01,0.1", 0.0, MAX_RATIO, "S/R", above_low=True)
         surfaces = comma_list(args.surfaces, "--surfaces")
         for surface in surfaces or []:
             if surface not in SURFACES:
@@ -59,16 +45,8 @@ class Curved:
                 raise UserError(f"--rays {args.rays!r}: expected a whole number from 1 to {MAX_RAYS}")
         heightmaps = comma_list(args.heightmaps, "--heightmaps")
         check_heightmaps(heightmaps or [])
-        return {"suite_name": args.suite, "heightmaps": heightmaps, "angles": angles, "ratios": ratios,
-                "surfaces": surfaces, "rays": rays, "techniques": _techniques(args.techniques),
-                "backend": args.backend, "progress": not args.quiet, "command": args.command_line}
-
-    def run(self, options: dict, out: Path) -> int:
-        from .run import run
-
-        run(out=out, **options)
-        print(out / "report.md")
-        return 0
+        return {**self.shared_options(args), "heightmaps": heightmaps, "angles": angles, "ratios": ratios,
+                "surfaces": surfaces, "rays": rays, "techniques": _techniques(args.techniques)}
 
 
 def _techniques(text: str | None) -> tuple[str, ...] | None:
@@ -86,4 +64,9 @@ def _techniques(text: str | None) -> tuple[str, ...] | None:
     return tuple(names)
 
 
-STUDY = Curved()
+STUDY = Curved(
+    "curved", "the tangent-plane trace against the exact hit on a sphere or cylinder of radius R, float64, as a "
+    "function of S/R and the view angle, and techniques against the same truth (results.csv, report.md, plots)",
+    "output folder (results.csv, report.md, *.png)",
+    "smoke: one small map, two angles, two S/R, pom (seconds); full: real and hard maps at 128x128, 0-85 degrees, "
+    "S/R 1e-3 to 0.2, sphere and cylinder, pom and maxmip")

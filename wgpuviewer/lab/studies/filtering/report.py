@@ -16,33 +16,18 @@ import math
 from collections import defaultdict
 from pathlib import Path
 
-import numpy as np
-
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import write_bytes
 from wgpuviewer.lab.harness.header import Header
-from wgpuviewer.lab.harness.plots import pyplot, save_png
 from wgpuviewer.relief.filters import get_filter
 
-from .suites import BASELINE, BILINEAR, EXACT, RUN_FILE, TABLE, Config, Suite
+from .aggregate import _fmt, _geomean, _mean, against, by_config, differences, label, ranked
+from .pictures import write_crops, write_distributions, write_pareto
+from .suites import BASELINE, BILINEAR, EXACT, RUN_FILE, TABLE, Suite
 from .views import ALBEDOS, HEIGHT_SCALE, RELIEFS, TECHNIQUE, Case
 
 __all__ = ["TABLE", "TITLE", "rereport", "write", "wanted_for_pictures", "recommendation"]
 
-#: The crops' panels: the reference, then these configurations (label, Config) where valid, then their
-#: difference images.
-CROP_PANELS = (
-    ("bilinear", BILINEAR),
-    ("trilinear", BASELINE),
-    ("aniso 16", Config("aniso", "uv", (("max_anisotropy", 16),))),
-    ("ewa analytic", Config("ewa", "analytic")),
-    ("ewa displaced", Config("ewa", "displaced")),
-    ("ewa_vis displ.", Config("ewa_vis", "displaced")),
-    ("inherit displ.", Config("ewa_vis", "displaced", (("inherit", 1),))),
-)
-DIFF_GAIN = 4.0  # difference images: |filter - reference| x this
-CROP = (40, 30)  # crop size, pixels (the window with the most occluded pixels)
-ZOOM = 4
 #: Albedo classes of the recommendation: does the albedo follow the relief's height?
 FOLLOWS = ("own", "masked")
 NEAR_BEST_DB = 0.5  # "cheapest within this of the best"
@@ -89,65 +74,6 @@ def rereport(csv: Path, out: Path) -> None:
                   "adapter": rows[0]["adapter"], "suite": "?", "started": None, "seconds": None, "void_notes": []}
     record["sources"] = [str(csv)]
     write_report(Path(out), rows, record)
-
-
-# --- aggregation ---------------------------------------------------------------------------------------------
-
-
-def _finite(values) -> list[float]:
-    return [float(v) for v in values if isinstance(v, (int, float)) and math.isfinite(v)]
-
-
-def _mean(values) -> float:
-    values = _finite(values)
-    return float(np.mean(values)) if values else float("nan")
-
-
-def _geomean(values) -> float:
-    values = [v for v in _finite(values) if v > 0]
-    return float(np.exp(np.mean(np.log(values)))) if values else float("nan")
-
-
-def ranked(rows: list[dict]) -> list[dict]:
-    """The rows that rank the filters: ranked cases, valid measurements."""
-    return [r for r in rows if r["role"] == "rank" and not r["void"]]
-
-
-def by_config(rows: list[dict]) -> dict[str, list[dict]]:
-    groups = defaultdict(list)
-    for row in rows:
-        groups[row["label"]].append(row)
-    return groups
-
-
-def label(filter_name: str, source: str, params: str = "", tracer: str = EXACT) -> str:
-    return f"{filter_name}{' ' + params if params else ''} ({source})" + ("" if tracer == EXACT else f" [{tracer}]")
-
-
-def _baseline_label(row: dict, config: Config) -> str:
-    return config.on(row["tracer"]).label
-
-
-def differences(rows: list[dict], a: str, b: str, key: str = "psnr") -> list[float]:
-    """Per case, row[key](label a) - row[key](label b), over the cases with both."""
-    per_case = defaultdict(dict)
-    for row in rows:
-        per_case[row["case"]][row["label"]] = row[key]
-    return [c[a] - c[b] for c in per_case.values() if a in c and b in c and math.isfinite(c[a] - c[b])]
-
-
-def against(rows: list[dict], config: Config) -> dict[str, list[float]]:
-    """label -> per-case PSNR differences against ``config`` on the label's own tracer."""
-    out = {}
-    for name, group in by_config(rows).items():
-        base = _baseline_label(group[0], config)
-        if name != base:
-            out[name] = differences(rows, name, base)
-    return out
-
-
-def _fmt(v: float, spec: str = "+.2f") -> str:
-    return "–" if not math.isfinite(v) else format(v, spec)
 
 
 # --- the recommendation ----------------------------------------------------------------------------------------
@@ -258,15 +184,7 @@ def visibility(rows: list[dict]) -> list[str]:
             plain = label("ewa", row0["derivatives"], tracer=row0["tracer"])
             box, gauss, occl = (_mean(differences(subset, name, plain, k))
                                 for k in ("psnr", "psnr_gauss", "psnr_occluded"))
-            better = worse = 0
-            per_case = {(r["case"], r["label"]): r for r in subset}
-            for r in group:
-                other = per_case.get((r["case"], plain))
-                if other is None:
-                    continue
-                margin = r["psnr_uncertainty"] + other["psnr_uncertainty"]
-                better += r["psnr"] - other["psnr"] > margin
-                worse += other["psnr"] - r["psnr"] > margin
+            better, worse = beyond_uncertainty(group, subset, plain)
             t = _geomean([r["time_ratio"] for r in group])
             te = t / _geomean([r["time_ratio"] for r in subset if r["label"] == plain])
             lines.append(f"| {title} | `{name}` | {_fmt(box)} / {_fmt(gauss)} / {_fmt(occl)} | {better} / {worse} | "
@@ -274,6 +192,15 @@ def visibility(rows: list[dict]) -> list[str]:
                          f"{_fmt(_mean(differences(subset, name, BILINEAR.on(row0['tracer']).label)))} | "
                          f"{_fmt(t, '.1f')} | {_fmt(te, '.1f')} | {len(group)} |")
     return lines
+
+
+def beyond_uncertainty(group: list[dict], rows: list[dict], other: str) -> tuple[int, int]:
+    """How many rows of ``group`` beat, and lose to, the row labelled ``other`` of the same case in ``rows`` by more
+    than both rows' reference uncertainty."""
+    by_case = {r["case"]: r for r in rows if r["label"] == other}
+    pairs = [(r, by_case[r["case"]]) for r in group if r["case"] in by_case]
+    margins = [(a["psnr"] - b["psnr"], a["psnr_uncertainty"] + b["psnr_uncertainty"]) for a, b in pairs]
+    return sum(d > m for d, m in margins), sum(-d > m for d, m in margins)
 
 
 def weighting(rows: list[dict]) -> list[str]:
@@ -329,179 +256,6 @@ def flicker(rows: list[dict]) -> list[str]:
     for name, fp, ratio, p in sorted(stats, key=lambda s: -s[1]):
         lines.append(f"| `{name}` | {fp:.2f} | {ratio:.2f} | {p:.2f} |")
     return lines
-
-
-# --- pictures ------------------------------------------------------------------------------------------------
-
-
-def _crop_window(mask: np.ndarray, size: tuple[int, int]) -> tuple[int, int]:
-    """(y, x) of the size window with the most True pixels (the first one on ties)."""
-    w, h = min(size[0], mask.shape[1]), min(size[1], mask.shape[0])
-    s = np.pad(np.cumsum(np.cumsum(mask.astype(np.int64), 0), 1), ((1, 0), (1, 0)))
-    counts = s[h:, w:] - s[:-h, w:] - s[h:, :-w] + s[:-h, :-w]
-    y, x = np.unravel_index(int(np.argmax(counts)), counts.shape)
-    return int(y), int(x)
-
-
-def write_crops(out: Path, result, void: set[str]) -> str:
-    import cv2
-
-    ref = result.reference
-    y, x = _crop_window(ref.occluded, CROP)
-    h, w = min(CROP[1], ref.color.shape[0]), min(CROP[0], ref.color.shape[1])
-
-    def crop(image):
-        return np.clip(image[y:y + h, x:x + w], 0.0, 1.0)
-
-    panels = [("reference", crop(ref.color))]
-    diffs = [("occluded pixels", np.repeat(crop(ref.occluded.astype(np.float64))[..., None], 3, axis=2))]
-    for name, config in CROP_PANELS:
-        image = result.images.get(config)
-        if image is None or config.label in void:
-            continue
-        panels.append((name, crop(image)))
-        diffs.append((f"|{name} - ref| x{DIFF_GAIN:g}", np.clip(np.abs(crop(image) - crop(ref.color)) * DIFF_GAIN, 0, 1)))
-
-    def strip(items):
-        tiles = []
-        for text, image in items:
-            big = cv2.resize((image * 255).round().astype(np.uint8), (w * ZOOM, h * ZOOM),
-                             interpolation=cv2.INTER_NEAREST)
-            header = np.full((18, w * ZOOM, 3), 255, np.uint8)
-            cv2.putText(header, text, (3, 13), cv2.FONT_HERSHEY_SIMPLEX, 0.42, (0, 0, 0), 1, cv2.LINE_AA)
-            tiles.append(np.concatenate([header, big], 0))
-            tiles.append(np.full((tiles[-1].shape[0], 4, 3), 255, np.uint8))
-        return np.concatenate(tiles[:-1], 1)
-
-    top, bottom = strip(panels), strip(diffs)
-    width = max(top.shape[1], bottom.shape[1])
-    parts = [np.pad(t, ((0, 0), (0, width - t.shape[1]), (0, 0)), constant_values=255) for t in (top, bottom)]
-    picture = np.concatenate([parts[0], np.full((6, width, 3), 255, np.uint8), parts[1]], 0)
-    name = f"crops_{result.case.name}.png"
-    ok, encoded = cv2.imencode(".png", cv2.cvtColor(picture, cv2.COLOR_RGB2BGR))
-    if not ok:
-        raise UserError(f"{out / name}: could not encode the PNG")
-    write_bytes(out / name, encoded.tobytes())
-    return name
-
-
-def place_labels(points: list[tuple[float, float]], widths: list[float], height: float, step: float,
-                 marker: float = 0.0) -> list[tuple[float, float]]:
-    """Offsets (display units) that keep every label's box (width x height, left edge at point + offset, centred
-    vertically) clear of the boxes placed before it and of every point's marker (a square of side 2 ``marker``):
-    right of the point first, then on its left, then further up or down in ``step``s."""
-    placed = [(px - marker, py - marker, px + marker, py + marker) for px, py in points]
-    offsets = []
-
-    def clear(box):
-        return all(box[2] <= b[0] or box[0] >= b[2] or box[3] <= b[1] or box[1] >= b[3] for b in placed)
-
-    for (px, py), w in zip(points, widths):
-        choice = None
-        for k in range(0, 60):
-            for dy in ((k * step,) if k == 0 else (k * step, -k * step)):
-                for dx in (marker + 2.0, -marker - 2.0 - w):
-                    box = (px + dx, py + dy - height / 2, px + dx + w, py + dy + height / 2)
-                    if clear(box):
-                        choice = (dx, dy, box)
-                        break
-                if choice:
-                    break
-            if choice:
-                break
-        if choice is None:  # more labels than room: the last resort overlaps
-            choice = (marker + 2.0, 0.0, (px + marker + 2.0, py - height / 2, px + marker + 2.0 + w, py + height / 2))
-        placed.append(choice[2])
-        offsets.append(choice[:2])
-    return offsets
-
-
-def write_pareto(path: Path, rows: list[dict]) -> str | None:
-    """Mean PSNR against the time ratio, one point per valid configuration, for relief with and without
-    occlusion; None without matplotlib."""
-    with pyplot() as plt:
-        return None if plt is None else _draw_pareto(plt, path, ranked(rows))
-
-
-def _draw_pareto(plt, path: Path, rows: list[dict]) -> str:
-    kinds = [k for k in (True, False) if any(r["occluding"] == k for r in rows)]
-    fig, axes = plt.subplots(1, len(kinds), figsize=(8 * len(kinds), 7), squeeze=False)
-    fontsize = 6.5
-    for ax, occluding in zip(axes[0], kinds):
-        subset = [r for r in rows if r["occluding"] == occluding]
-        points = []
-        for name, group in by_config(subset).items():
-            t, p = _geomean([r["time_ratio"] for r in group]), _mean([r["psnr"] for r in group])
-            if math.isfinite(t) and math.isfinite(p):
-                points.append((t, p, name))
-        for t, p, name in points:
-            colour = "tab:red" if "vis" in name else ("tab:blue" if "ewa" in name else "tab:grey")
-            ax.scatter(t, p, color=colour, s=18, marker="s" if "pom32" in name else "o")
-        front, best = [], -math.inf
-        for t, p, _ in sorted(points):
-            if p > best:
-                best = p
-                front.append((t, p))
-        if front:
-            ax.plot(*zip(*front), color="black", linewidth=0.8, linestyle="--", label="Pareto front")
-            ax.legend(fontsize=7, loc="lower right")
-        ax.set_xscale("log")
-        ax.set_xlabel("GPU time / trilinear on the same tracer (geometric mean; software adapter)")
-        ax.set_ylabel("PSNR against the box reference, dB (mean)")
-        ax.set_title("relief with occlusion" if occluding else "flat relief")
-        ax.grid(True, which="both")
-        if points:
-            ax.margins(x=0.25, y=0.12)
-            fig.canvas.draw()
-            xy = ax.transData.transform([(t, p) for t, p, _ in points])
-            char_w = fontsize * 0.55 * fig.dpi / 72
-            height = fontsize * 1.25 * fig.dpi / 72
-            order = np.argsort(-xy[:, 1])
-            offsets = place_labels([tuple(xy[i]) for i in order], [len(points[i][2]) * char_w for i in order],
-                                   height, height * 0.6, marker=3.0 * fig.dpi / 72)
-            for i, (dx, dy) in zip(order, offsets):
-                t, p, name = points[i]
-                pts = 72 / fig.dpi
-                ax.annotate(name, (t, p), xytext=(dx * pts, dy * pts), textcoords="offset points", fontsize=fontsize,
-                            va="center", arrowprops={"arrowstyle": "-", "color": "0.6", "linewidth": 0.5}
-                            if dy else None)
-    fig.tight_layout()
-    return save_png(fig, path, dpi=120, tight=False)
-
-
-def write_distributions(path: Path, rows: list[dict]) -> str | None:
-    """Per configuration, the per-case PSNR differences against trilinear and against bilinear (same tracer) as
-    box plots with every case's point over them, on the occluding cases; None without matplotlib."""
-    with pyplot() as plt:
-        return None if plt is None else _draw_distributions(plt, path, [r for r in ranked(rows) if r["occluding"]])
-
-
-def _draw_distributions(plt, path: Path, rows: list[dict]) -> str | None:
-    panels = [(f"PSNR - {BASELINE.label} (same tracer), dB", against(rows, BASELINE)),
-              (f"PSNR - {BILINEAR.label} (same tracer), dB", against(rows, BILINEAR))]
-    def order(name):  # by the mean gain over trilinear; trilinear itself (no difference) at the bottom
-        m = _mean(panels[0][1].get(name, []))
-        return m if math.isfinite(m) else -math.inf
-
-    names = sorted({n for _, d in panels for n in d}, key=order)
-    names = [n for n in names if any(d.get(n) for _, d in panels)]
-    if not names:
-        return None
-    fig, axes = plt.subplots(1, 2, figsize=(14, 0.32 * len(names) + 1.8), sharey=True)
-    rng = np.random.default_rng(0)
-    for ax, (title, data) in zip(axes, panels):
-        values = [data.get(n, []) for n in names]
-        ax.boxplot([v if v else [math.nan] for v in values], orientation="horizontal", widths=0.6, showfliers=False)
-        for i, v in enumerate(values, start=1):
-            ax.scatter(v, i + rng.uniform(-0.18, 0.18, len(v)), s=6, alpha=0.5, color="tab:blue")
-        ax.axvline(0.0, color="black", linewidth=0.8)
-        ax.set_xlabel(title)
-        ax.grid(True, axis="x")
-    axes[0].set_yticks(range(1, len(names) + 1), names, fontsize=7)
-    axes[0].set_title("relief with occlusion: per-case differences (box: quartiles; dots: cases)", fontsize=9,
-                      loc="left")
-    fig.tight_layout()
-    return save_png(fig, path, dpi=110, tight=False)
 
 
 # --- report.md -------------------------------------------------------------------------------------------------
@@ -581,15 +335,24 @@ def markdown(rows: list[dict], record: dict, pictures: list[str], pareto: str | 
                           ("Flat relief", [r for r in ranked(rows) if not r["occluding"]])):
         if subset:
             lines += [f"## {title} ({len({r['case'] for r in subset})} cases)", "", *_table(subset), ""]
-    lines += ["## Per case", "",
-              "The reference's own error: its half-ray version's PSNR against it; rays: where that error hid a "
-              "compared difference (visibility against EWA, inherit against drop, EWA against the baselines) the "
-              "rays were doubled up to the suite's most; resolved: every such difference of at least "
-              f"{0.1} dB exceeds both rows' reference uncertainty.", "",
-              "| case | occluded px | reference rays | half vs full, PSNR dB | resolved | best valid | its PSNR | "
-              "trilinear | bilinear | ewa_vis - ewa (displaced / analytic) | inherit - drop (displaced) | "
-              "ewa capped | displaced ratio p99 / max |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines += per_case(rows, record)
+    lines += ["", "Reliefs: " + "; ".join(f"`{k}` {v}" for k, v in RELIEFS.items()) + ".",
+              "Albedos: " + "; ".join(f"`{k}` {v}" for k, v in ALBEDOS.items()) + ".", ""]
+    return "\n".join(lines)
+
+
+def per_case(rows: list[dict], record: dict) -> list[str]:
+    """The report's per-case table (exact tracer): the reference's own error, the best valid configuration, the
+    baselines, visibility's and the weighting's differences, EWA's capped share, the displaced ratio."""
+    lines = ["## Per case", "",
+             "The reference's own error: its half-ray version's PSNR against it; rays: where that error hid a "
+             "compared difference (visibility against EWA, inherit against drop, EWA against the baselines) the "
+             "rays were doubled up to the suite's most; resolved: every such difference of at least "
+             f"{0.1} dB exceeds both rows' reference uncertainty.", "",
+             "| case | occluded px | reference rays | half vs full, PSNR dB | resolved | best valid | its PSNR | "
+             "trilinear | bilinear | ewa_vis - ewa (displaced / analytic) | inherit - drop (displaced) | "
+             "ewa capped | displaced ratio p99 / max |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     intro = measures(rows, record.get("reference", 16))
     if intro:
         lines[-3:-3] = [*intro, ""]
@@ -614,33 +377,4 @@ def markdown(rows: list[dict], record: dict, pictures: list[str], pareto: str | 
             f"{_fmt(psnrs.get(BASELINE.label, math.nan), '.2f')} | {_fmt(psnrs.get(BILINEAR.label, math.nan), '.2f')} "
             f"| {vis} | {delta(label('ewa_vis', 'displaced', 'inherit=1'), label('ewa_vis', 'displaced'))} | "
             f"{ewa['capped_share']:.1%} | {disp['ratio_p99']:.1f} / {disp['ratio_max']:.3g} |")
-    lines += ["", "Reliefs: " + "; ".join(f"`{k}` {v}" for k, v in RELIEFS.items()) + ".",
-              "Albedos: " + "; ".join(f"`{k}` {v}" for k, v in ALBEDOS.items()) + ".", ""]
-    return "\n".join(lines)
-
-
-# --- docs/filtering.md's generated block ---------------------------------------------------------------------
-
-DOCS_BEGIN = "<!-- generated: filtering results -->"
-DOCS_END = "<!-- end generated -->"
-
-
-def docs_block(rows: list[dict], record: dict) -> str:
-    """The numbers docs/filtering.md quotes, generated from a committed results.csv (tests/lab/studies/filtering holds
-    the page to it): the recommendation, EWA by derivative source, visibility, the weighting and flicker."""
-    void_labels = sorted({r["label"] for r in rows if r["void"]})
-    lines = [DOCS_BEGIN, "", *recommendation(rows), "", "Plain EWA by derivative source (exact tracer):", "",
-             *derivative_sources(rows), "", "Visibility against plain EWA on the same footprint:", "",
-             *visibility(rows), "", *weighting(rows), "", *flicker(rows), "", *tuning(rows), "",
-             *measures(rows, record.get("reference", 16)), ""]
-    if void_labels:
-        lines += [f"Void on this adapter (in results.csv, in no aggregate): {', '.join(f'`{v}`' for v in void_labels)}"
-                  f". {' '.join(record.get('void_notes', []))}", ""]
-    lines.append(DOCS_END)
-    return "\n".join(lines)
-
-
-def docs_block_of(folder: Path) -> str:
-    """``docs_block`` of the run in ``folder`` (its results.csv and run.json)."""
-    return docs_block(TABLE.read(Path(folder) / "results.csv"),
-                      json.loads((Path(folder) / RUN_FILE).read_text()))
+    return lines

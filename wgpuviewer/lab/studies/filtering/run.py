@@ -4,7 +4,7 @@ reference.
 Per case (relief x albedo x view angle x minification, ``views``): the reference at ``reference`` x ``reference``
 rays per pixel and at half that (its own error), then per configuration one render of the filtered albedo
 (``mode="albedo"``: the albedo lookup alone, unlit) with its statistics, and the GPU time of all configurations
-drawn round robin in the same renderer (``relief.timing``), as a ratio to ``trilinear`` on the unperturbed uv
+drawn round robin in the same renderer (``relief.draw_timing``), as a ratio to ``trilinear`` on the unperturbed uv
 after the same tracer. Errors: PSNR and SSIM (scikit-image) of the sRGB image against the box-filtered reference
 over the pixels the plane covers, PSNR against the Gaussian reference, and PSNR over the pixels whose footprint
 contains hidden texels (``supersample.occluded_pixels``).
@@ -124,7 +124,7 @@ def unresolved(rows: list[dict]) -> list[tuple[str, str]]:
 
 
 def measure_case(view: View, suite: Suite, configs, gpu, void: dict, progress=None) -> tuple[list[dict], CaseResult]:
-    from wgpuviewer.relief.timing import time_draws
+    from wgpuviewer.relief.draw_timing import time_draws
 
     renderer = Renderer(view.scene, gpu)
     n = suite.reference

@@ -15,9 +15,10 @@ Two builds of every loop:
   running sums cannot (a float recurrence is not reassociated). ``vectorisation`` reads the optimised LLVM IR to
   say which loops were vectorised and how wide.
 
-Every loop has the same arguments (``Arguments``): the coefficients in the loop's precision, what the
-double-single and fixed-point forms add (the increment's low part, the fixed-point start values, steps and
-scales), the spans (x0, y, the span setup's clip [first, end)), the method's parameter, and the outputs.
+The loops' source is ``loops`` (``loops.loop_sources``). Every loop has the same arguments (``Arguments``): the
+coefficients in the loop's precision, what the double-single and fixed-point forms add (the increment's low part,
+the fixed-point start values, steps and scales), the spans (x0, y, the span setup's clip [first, end)), the method's
+parameter, and the outputs.
 """
 
 from __future__ import annotations
@@ -32,11 +33,10 @@ import numpy as np
 
 from wgpuviewer.core.errors import UserError
 
-from .geometry import UMAX, Spans, defined_range
+from .geometry import Spans, defined_range
+from .loops import loop_sources
 from .methods import METHODS, PRECISION_DTYPE, Result, fixed_setup, split
 
-#: The most lanes the parallel form keeps (methods.PARALLEL_THREADS).
-MAX_LANES = 32
 BUILDS = ("scalar", "simd")
 
 
@@ -47,288 +47,6 @@ def numba_module():
     except ImportError:
         raise UserError("the perspective study's compiled loops need numba: pip install 'wgpuviewer[bench]'") from None
     return numba
-
-
-def loop_sources(ftype) -> dict[str, Callable]:
-    """Every loop as a Python function in the float type ``ftype`` (np.float32 or np.float64), for numba; the
-    per-pixel helpers they call are compiled with the first loop that calls them, so each build gets its own."""
-    numba = numba_module()
-    jit = numba.njit(fastmath=False, error_model="numpy", nogil=True)
-    zero, one, two, umax = ftype(0), ftype(1), ftype(2), ftype(UMAX)
-
-    @jit
-    def put(ru, rv, rf, n, wu, wv, q, inside):
-        """Pixel n from (w_u, w_v, q): the divisions, or 0 and a flag (methods._divide)."""
-        ok = (q > zero) & (abs(wu) <= umax * q) & (abs(wv) <= umax * q) & inside
-        u = wu / q
-        v = wv / q
-        ru[n] = u if ok else zero
-        rv[n] = v if ok else zero
-        rf[n] = not ok
-
-    @jit
-    def put_rcp(ru, rv, rf, n, wu, wv, q, inside):
-        """Pixel n with one division (methods._reciprocal)."""
-        ok = (q > zero) & (abs(wu) <= umax * q) & (abs(wv) <= umax * q) & inside
-        r = one / q
-        u = wu * r
-        v = wv * r
-        ru[n] = u if ok else zero
-        rv[n] = v if ok else zero
-        rf[n] = not ok
-
-    @jit
-    def exact(su, sv, sq, au, av, aq, p, inside):
-        """u, v and flag at span position p by the span form (0 where flagged): an anchor of the subdivisions."""
-        pf = ftype(p)
-        wu = su + au * pf
-        wv = sv + av * pf
-        q = sq + aq * pf
-        ok = (q > zero) & (abs(wu) <= umax * q) & (abs(wv) <= umax * q) & inside
-        u = wu / q
-        v = wv / q
-        return (u if ok else zero), (v if ok else zero), not ok, q
-
-    @jit
-    def line(ru, rv, rf, a, b, cu, cv, cf, du, dv, df):
-        """Pixels a .. b - 1 linear from anchor a (cu, cv, cf) towards anchor b (du, dv, df) (methods._interpolate)."""
-        width = ftype(b - a)
-        slope_u = (du - cu) / width
-        slope_v = (dv - cv) / width
-        flagged = cf | df
-        for m in range(b - a):
-            mf = ftype(m)
-            lu = cu + mf * slope_u
-            lv = cv + mf * slope_v
-            ru[a + m] = zero if flagged else lu
-            rv[a + m] = zero if flagged else lv
-            rf[a + m] = flagged
-
-    @jit
-    def start(k, x0, y):
-        """The per-span constants a x0 + b y + c (methods.span_start)."""
-        xf, yf = ftype(x0), ftype(y)
-        return ((k[0, 0] * xf + k[0, 1] * yf) + k[0, 2], (k[1, 0] * xf + k[1, 1] * yf) + k[1, 2],
-                (k[2, 0] * xf + k[2, 1] * yf) + k[2, 2])
-
-    def direct_like(store):
-        def loop(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-            au, bu, cu = k[0, 0], k[0, 1], k[0, 2]
-            av, bv, cv = k[1, 0], k[1, 1], k[1, 2]
-            aq, bq, cq = k[2, 0], k[2, 1], k[2, 2]
-            length = out_u.shape[1]
-            for s in range(x0.size):
-                ru, rv, rf = out_u[s], out_v[s], out_f[s]
-                yf, xs, lo, hi = ftype(y[s]), x0[s], first[s], end[s]
-                for n in range(length):
-                    x = ftype(xs + n)
-                    store(ru, rv, rf, n, (au * x + bu * yf) + cu, (av * x + bv * yf) + cv, (aq * x + bq * yf) + cq,
-                          (n >= lo) & (n < hi))
-        return loop
-
-    def span_like(store):
-        def loop(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-            au, av, aq = k[0, 0], k[1, 0], k[2, 0]
-            length = out_u.shape[1]
-            for s in range(x0.size):
-                ru, rv, rf = out_u[s], out_v[s], out_f[s]
-                su, sv, sq = start(k, x0[s], y[s])
-                lo, hi = first[s], end[s]
-                for n in range(length):
-                    nf = ftype(n)
-                    store(ru, rv, rf, n, su + au * nf, sv + av * nf, sq + aq * nf, (n >= lo) & (n < hi))
-        return loop
-
-    def incremental(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-        au, av, aq = k[0, 0], k[1, 0], k[2, 0]
-        length = out_u.shape[1]
-        for s in range(x0.size):
-            ru, rv, rf = out_u[s], out_v[s], out_f[s]
-            wu, wv, q = start(k, x0[s], y[s])
-            lo, hi = first[s], end[s]
-            for n in range(length):
-                put(ru, rv, rf, n, wu, wv, q, (n >= lo) & (n < hi))
-                wu = wu + au
-                wv = wv + av
-                q = q + aq
-
-    def parallel(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-        au, av, aq = k[0, 0], k[1, 0], k[2, 0]
-        lanes = min(max(param, 1), MAX_LANES)
-        stride_u, stride_v, stride_q = au * ftype(lanes), av * ftype(lanes), aq * ftype(lanes)
-        lane_u, lane_v, lane_q = np.empty(MAX_LANES, ftype), np.empty(MAX_LANES, ftype), np.empty(MAX_LANES, ftype)
-        length = out_u.shape[1]
-        for s in range(x0.size):
-            ru, rv, rf = out_u[s], out_v[s], out_f[s]
-            wu, wv, q = start(k, x0[s], y[s])
-            lo, hi = first[s], end[s]
-            for j in range(lanes):  # lane j starts at w_j, by j steps of formula (4)
-                lane_u[j], lane_v[j], lane_q[j] = wu, wv, q
-                wu = wu + au
-                wv = wv + av
-                q = q + aq
-            for base in range(0, length, lanes):
-                for j in range(min(lanes, length - base)):
-                    n = base + j
-                    put(ru, rv, rf, n, lane_u[j], lane_v[j], lane_q[j], (n >= lo) & (n < hi))
-                    lane_u[j] = lane_u[j] + stride_u
-                    lane_v[j] = lane_v[j] + stride_v
-                    lane_q[j] = lane_q[j] + stride_q
-
-    def two_ended(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-        au, av, aq = k[0, 0], k[1, 0], k[2, 0]
-        length = out_u.shape[1]
-        half = (length + 1) // 2
-        last = ftype(length - 1)
-        for s in range(x0.size):
-            ru, rv, rf = out_u[s], out_v[s], out_f[s]
-            su, sv, sq = start(k, x0[s], y[s])
-            lo, hi = first[s], end[s]
-            wu, wv, q = su, sv, sq
-            for n in range(half):
-                put(ru, rv, rf, n, wu, wv, q, (n >= lo) & (n < hi))
-                wu = wu + au
-                wv = wv + av
-                q = q + aq
-            wu, wv, q = su + au * last, sv + av * last, sq + aq * last
-            for i in range(length - half):  # w + (-a) is w - a exactly
-                n = length - 1 - i
-                put(ru, rv, rf, n, wu, wv, q, (n >= lo) & (n < hi))
-                wu = wu + -au
-                wv = wv + -av
-                q = q + -aq
-
-    def subdivided(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-        au, av, aq = k[0, 0], k[1, 0], k[2, 0]
-        every = max(param, 1)
-        length = out_u.shape[1]
-        for s in range(x0.size):
-            ru, rv, rf = out_u[s], out_v[s], out_f[s]
-            su, sv, sq = start(k, x0[s], y[s])
-            lo, hi = first[s], end[s]
-            cu, cv, cf, _ = exact(su, sv, sq, au, av, aq, 0, (lo <= 0) & (hi > 0))
-            a = 0
-            while a < length - 1:
-                b = min(a + every, length - 1)
-                du, dv, df, _ = exact(su, sv, sq, au, av, aq, b, (b >= lo) & (b < hi))
-                line(ru, rv, rf, a, b, cu, cv, cf, du, dv, df)
-                a, cu, cv, cf = b, du, dv, df
-            ru[length - 1] = cu
-            rv[length - 1] = cv
-            rf[length - 1] = cf
-
-    def adaptive(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-        au, av, aq = k[0, 0], k[1, 0], k[2, 0]
-        # methods.segment_rule
-        ad = abs(aq)
-        m = -aq if aq < zero else zero
-        e = ftype(param)
-        m2, de, scale = m * m, ad * e, two / (e * ad)
-        length = out_u.shape[1]
-        for s in range(x0.size):
-            ru, rv, rf = out_u[s], out_v[s], out_f[s]
-            su, sv, sq = start(k, x0[s], y[s])
-            lo, hi = first[s], end[s]
-            cu, cv, cf, q = exact(su, sv, sq, au, av, aq, 0, (lo <= 0) & (hi > 0))
-            a = 0
-            while a < length - 1:
-                remaining = length - 1 - a
-                step = 1  # methods.segment_length
-                if ad == zero:
-                    step = remaining
-                elif q > zero:
-                    sl = (np.sqrt(m2 + de * q) - m) * scale
-                    if sl >= one:
-                        step = int(np.floor(min(sl, ftype(remaining))))
-                b = a + step
-                du, dv, df, q = exact(su, sv, sq, au, av, aq, b, (b >= lo) & (b < hi))
-                line(ru, rv, rf, a, b, cu, cv, cf, du, dv, df)
-                a, cu, cv, cf = b, du, dv, df
-            ru[length - 1] = cu
-            rv[length - 1] = cv
-            rf[length - 1] = cf
-
-    def reanchor(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-        au, av, aq = k[0, 0], k[1, 0], k[2, 0]
-        every = max(param, 1)
-        length = out_u.shape[1]
-        for s in range(x0.size):
-            ru, rv, rf = out_u[s], out_v[s], out_f[s]
-            su, sv, sq = start(k, x0[s], y[s])
-            lo, hi = first[s], end[s]
-            wu, wv, q = su, sv, sq
-            for n in range(length):
-                if n % every == 0:
-                    nf = ftype(n)
-                    wu, wv, q = su + au * nf, sv + av * nf, sq + aq * nf
-                put(ru, rv, rf, n, wu, wv, q, (n >= lo) & (n < hi))
-                wu = wu + au
-                wv = wv + av
-                q = q + aq
-
-    def kahan(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-        au, av, aq = k[0, 0], k[1, 0], k[2, 0]
-        length = out_u.shape[1]
-        for s in range(x0.size):
-            ru, rv, rf = out_u[s], out_v[s], out_f[s]
-            wu, wv, q = start(k, x0[s], y[s])
-            cu = cv = cq = zero
-            lo, hi = first[s], end[s]
-            for n in range(length):
-                put(ru, rv, rf, n, wu, wv, q, (n >= lo) & (n < hi))
-                yu, yv, yq = au - cu, av - cv, aq - cq
-                tu, tv, tq = wu + yu, wv + yv, q + yq
-                cu, cv, cq = (tu - wu) - yu, (tv - wv) - yv, (tq - q) - yq
-                wu, wv, q = tu, tv, tq
-
-    @jit
-    def two_float_step(h, lo, a, a_lo):
-        """hi + lo plus a + a_lo: TwoSum of h + a, then the low parts (methods.double_single)."""
-        sm = h + a
-        bb = sm - h
-        err = (h - (sm - bb)) + (a - bb)
-        e = err + (lo + a_lo)
-        h2 = sm + e
-        return h2, e - (h2 - sm)
-
-    def double_single(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-        au, av, aq = k[0, 0], k[1, 0], k[2, 0]
-        lu, lv, lq = a_lo[0], a_lo[1], a_lo[2]
-        length = out_u.shape[1]
-        for s in range(x0.size):
-            ru, rv, rf = out_u[s], out_v[s], out_f[s]
-            hu, hv, hq = start(k, x0[s], y[s])
-            ou = ov = oq = zero
-            lo, hi = first[s], end[s]
-            for n in range(length):
-                put(ru, rv, rf, n, hu + ou, hv + ov, hq + oq, (n >= lo) & (n < hi))
-                hu, ou = two_float_step(hu, ou, au, lu)
-                hv, ov = two_float_step(hv, ov, av, lv)
-                hq, oq = two_float_step(hq, oq, aq, lq)
-
-    def fixed16_16(k, a_lo, ratio, fx_step, fx_start, x0, y, first, end, param, out_u, out_v, out_f):
-        su, sv, sq = fx_step[0], fx_step[1], fx_step[2]
-        length = out_u.shape[1]
-        for s in range(x0.size):
-            ru, rv, rf = out_u[s], out_v[s], out_f[s]
-            wu, wv, q = fx_start[s, 0], fx_start[s, 1], fx_start[s, 2]
-            lo, hi = first[s], end[s]
-            for n in range(length):
-                fu, fv, fq = ftype(wu), ftype(wv), ftype(q)
-                u = (fu / fq) * ratio[0]
-                v = (fv / fq) * ratio[1]
-                ok = (fq > zero) & (abs(u) <= umax) & (abs(v) <= umax) & (n >= lo) & (n < hi)
-                ru[n] = u if ok else zero
-                rv[n] = v if ok else zero
-                rf[n] = not ok
-                wu = np.int32(wu + su)  # int32 wraps, as the numpy twin's and WGSL's i32 sums
-                wv = np.int32(wv + sv)
-                q = np.int32(q + sq)
-
-    return {"direct": direct_like(put), "direct_rcp": direct_like(put_rcp), "span": span_like(put),
-            "span_rcp": span_like(put_rcp), "incremental": incremental, "parallel": parallel, "two_ended": two_ended,
-            "subdivided": subdivided, "adaptive": adaptive, "reanchor": reanchor, "kahan": kahan,
-            "double_single": double_single, "fixed16_16": fixed16_16}
 
 
 #: The loops, by ``Method.kernel``.
@@ -410,9 +128,10 @@ class Build:
         dtype = np.dtype(dtype).type
         key = (kernel, dtype)
         if key not in self._loops:
+            jit = numba.njit(fastmath=False, error_model="numpy", nogil=True)
             if dtype not in self._sources:
-                self._sources[dtype] = loop_sources(dtype)
-            dispatcher = numba.njit(fastmath=False, error_model="numpy", nogil=True)(self._sources[dtype][kernel])
+                self._sources[dtype] = loop_sources(jit, dtype)
+            dispatcher = jit(self._sources[dtype][kernel])
             f, i32, i64 = numba.from_dtype(np.dtype(dtype)), numba.int32, numba.int64
             arr = numba.types.Array
             signature = (arr(f, 2, "C"), arr(f, 1, "C"), arr(f, 1, "C"), arr(i32, 1, "C"), arr(i32, 2, "C"),

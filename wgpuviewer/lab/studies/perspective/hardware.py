@@ -39,7 +39,7 @@ def hardware_uv(quad: Quad, gpu: Gpu, renderer: Renderer | None = None) -> Resul
 
 
 def frame_recorder(quad: Quad, renderer: Renderer):
-    """A core.timing recorder: one render pass of the quad (``basic``, colour target, as the window draws)."""
+    """A core.pass_timing recorder: one render pass of the quad (``basic``, colour target, as the window draws)."""
     device = renderer.gpu.device
     w, h = quad.frame
     usage = wgpu.TextureUsage.RENDER_ATTACHMENT

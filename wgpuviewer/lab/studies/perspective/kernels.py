@@ -159,7 +159,7 @@ class Dispatch:
     spans: Spans
 
     def record(self, encoder: wgpu.GPUCommandEncoder, timestamp_writes: dict | None = None) -> None:
-        """One compute pass with the method's dispatches (a core.timing recorder)."""
+        """One compute pass with the method's dispatches (a core.pass_timing recorder)."""
         compute = encoder.begin_compute_pass(label="perspective", timestamp_writes=timestamp_writes)
         compute.set_bind_group(0, self.group)
         for pipeline, groups in self.steps:

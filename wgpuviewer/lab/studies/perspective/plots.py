@@ -11,7 +11,7 @@ import numpy as np
 from wgpuviewer.lab.harness.plots import pyplot, save_png
 
 from .methods import METHODS
-from .report import (
+from .selection import (
     APPROXIMATIONS,
     MITIGATIONS,
     PAPER_F32,

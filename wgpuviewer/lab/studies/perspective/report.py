@@ -7,21 +7,40 @@ is off), texels beside them where the texture's own scale matters (coordinate ma
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from wgpuviewer.lab.harness.plots import MISSING
 
 from .methods import ADAPTIVE_FRACTIONS, METHODS, PARALLEL_THREADS
-
-PAPER_F32 = ["direct", "span", "incremental", *(f"parallel_{k}" for k in PARALLEL_THREADS), "two_ended"]
-RECIPROCAL = [m.name for m in METHODS.values() if m.family == "reciprocal"]
-APPROXIMATIONS = [m.name for m in METHODS.values() if m.family == "approximation"]
-MITIGATIONS = [m.name for m in METHODS.values() if m.family == "mitigation"]
-#: The largest error (screen pixels, worst pixel of every configuration in a regime) a recommendation accepts.
-BUDGET_PX = 0.25
-DRIFT_BUDGETS = (0.1, 0.5, 1.0)  # screen pixels
+from .selection import (
+    APPROXIMATIONS,
+    BUDGET_PX,
+    DRIFT_BUDGETS,
+    MITIGATIONS,
+    PAPER_F32,
+    RECIPROCAL,
+    _err,
+    _f,
+    _finite,
+    _named,
+    first_row,
+    fitted_length,
+    power_fit,
+    select_rows,
+    single_precision,
+    speed_frames,
+    speed_row,
+)
+from .tables import (
+    adaptive_table,
+    check_lines,
+    compiled_table,
+    gpu_table,
+    operations_table,
+    sweep_table,
+    tieback_table,
+    tile_table,
+)
 
 
 def every_row(_row) -> bool:
@@ -37,71 +56,6 @@ REGIMES = (
     ("grazing (85° to 89.9°)", "tilt", lambda r: is_grazing(r)),
     ("large coordinates (offsets of 10^4 texels and more)", "magnitude", lambda r: r["offset_texels"] >= 1e4),
 )
-
-
-def _f(x, digits: int = 3) -> str:
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "–"
-    if isinstance(x, float) and (x == 0 or 1e-3 <= abs(x) < 1e5):
-        return f"{x:.{digits}g}"
-    if isinstance(x, float):
-        return f"{x:.{max(digits - 1, 1)}e}"
-    return str(x)
-
-
-def first_row(rows, **match):
-    for r in rows:
-        if all(r.get(k) == v for k, v in match.items()):
-            return r
-    return None
-
-
-def select_rows(rows, **match):
-    return [r for r in rows if all(r.get(k) == v for k, v in match.items())]
-
-
-def single_precision(name: str) -> str:
-    return "float32" if name == "hardware" else METHODS[name].precisions[0]
-
-
-def _err(rows, sweep, method, key="max_err_px", **match):
-    r = first_row(rows, sweep=sweep, method=method, precision=single_precision(method), **match)
-    return r[key] if r and r[key] is not None else float("nan")
-
-
-def _finite(x) -> bool:
-    return isinstance(x, float) and math.isfinite(x)
-
-
-def power_fit(lengths, errors) -> tuple[float, float, float]:
-    """Least-squares fit error ~ c L^p in log-log: (p, log c, the largest factor a point lies off the fit)."""
-    pairs = [(math.log(n), math.log(e)) for n, e in zip(lengths, errors) if e > 0 and math.isfinite(e)]
-    if len(pairs) < 2:
-        return float("nan"), float("nan"), float("nan")
-    x, y = np.array(pairs).T
-    slope, offset = np.polyfit(x, y, 1)
-    return float(slope), float(offset), float(np.exp(np.abs(y - (slope * x + offset)).max()))
-
-
-def fitted_length(slope: float, offset: float, budget: float) -> float:
-    """The span length where the fitted error reaches ``budget``."""
-    return math.exp((math.log(budget) - offset) / slope) if slope > 0 else float("nan")
-
-
-def speed_frames(rows) -> list[tuple[int, int]]:
-    return list(dict.fromkeys((r["span_length"], r["spans"]) for r in select_rows(rows, sweep="speed")))
-
-
-def speed_row(rows, method: str, frame: tuple[int, int] | None = None):
-    frames = speed_frames(rows)
-    if not frames:
-        return None
-    w, h = frame or frames[0]
-    return first_row(rows, sweep="speed", method=method, span_length=w, spans=h)
-
-
-def _named(r, key: str, unit: str = "×") -> str:
-    return f"`{r['method']}` {_f(r[key])}{unit}"
 
 
 # --- the recommendation -----------------------------------------------------------------------------------------
@@ -369,155 +323,6 @@ def approximation_answer(rows) -> str:
             f"u = w / q (docs/perspective.md) to stay within 1/E px ({bounds}).")
 
 
-# --- tables -----------------------------------------------------------------------------------------------------
-
-
-def _table(header: list[str], body: list[list]) -> list[str]:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(_f(c) if not isinstance(c, str) else c for c in row) + " |" for row in body]
-    return lines
-
-
-def _point(key: str, p) -> str:
-    if key == "span_length":
-        return str(int(p))
-    if key == "tilt_deg" and p >= 90:
-        return f"{p:g} (flagged beyond the horizon)"
-    return _f(p) if isinstance(p, float) else str(p)
-
-
-def sweep_table(rows, sweep: str, key: str, methods, value="max_err_px") -> list[str]:
-    points = sorted({r[key] for r in select_rows(rows, sweep=sweep)})
-    header = [key, *(f"`{m}`" for m in methods)]
-    body = [[_point(key, p), *(_err(rows, sweep, m, value, **{key: p}) for m in methods)] for p in points]
-    return _table(header, body)
-
-
-def _timing(r, build: str) -> str:
-    return f"{_f(r[f'{build}_ns'])} (±{_f(r[f'{build}_spread'] * 50, 2)} %)"
-
-
-def compiled_table(rows) -> list[str]:
-    frames = speed_frames(rows)
-    if not frames:
-        return ["Not measured."]
-    w, h = frames[0]
-    others = frames[1:]
-    tiles = select_rows(rows, sweep="speed_tile")
-    header = ["method", "scalar ns/texel", "scalar × direct", "SIMD ns/texel", "SIMD × direct", "LLVM made",
-              *(f"scalar / SIMD × direct, {int(fh)}×{int(fw)}" for fw, fh in others),
-              *([f"scalar / SIMD × direct, in {int(tiles[0]['span_length'])}-pixel spans"] if tiles else []),
-              "max error (px)", "max error (texels)", "exact per pixel"]
-    body = []
-    for name in METHODS:
-        r = speed_row(rows, name)
-        if not r:
-            continue
-        extra = []
-        for o in [speed_row(rows, name, frame) for frame in others] + ([first_row(tiles, method=name)] if tiles else []):
-            extra.append(f"{_f(o['scalar_ratio'])} / {_f(o['simd_ratio'])}" if o else "–")
-        body.append([f"`{name}`", _timing(r, "scalar"), r["scalar_ratio"], _timing(r, "simd"), r["simd_ratio"],
-                     r["simd_vectorised"] or "–", *extra, r["max_err_px"], r["max_err"], r["exact_per_pixel"]])
-    return [f"{int(h)} spans of {int(w)} pixels; the first precision of each method.", "", *_table(header, body)]
-
-
-def operations_table(rows) -> list[str]:
-    header = ["method", "paper add/mul/div", "code add/mul/div", "+ guard / int add / sqrt",
-              "with FMA: add/mul/fma/div", "exact per pixel"]
-    body = []
-    for name, method in METHODS.items():
-        r = speed_row(rows, name)
-        if not r:
-            continue
-        paper = (f"{r['paper_adds']:g}/{r['paper_muls']:g}/{r['paper_divs']:g} ({method.paper_note})"
-                 if r["paper_adds"] is not None else "–")
-        body.append([f"`{name}`", paper,
-                     f"{_f(r['adds_per_texel'])}/{_f(r['muls_per_texel'])}/{_f(r['divs_per_texel'])}",
-                     f"{_f(r['guards_per_texel'])} / {_f(r['int_adds_per_texel'])} / {_f(r['sqrts_per_texel'])}",
-                     f"{_f(r['fma_adds_per_texel'])}/{_f(r['fma_muls_per_texel'])}/{_f(r['fma_fmas_per_texel'])}/"
-                     f"{_f(r['divs_per_texel'])}", r["exact_per_pixel"]])
-    return _table(header, body)
-
-
-def gpu_table(rows, software: bool) -> list[str]:
-    frames = speed_frames(rows)
-    label = "software GPU adapter" if software else "GPU"
-    header = ["method", *(f"{label} × direct, {int(h)}×{int(w)} (spread)" for w, h in frames),
-              *(f"numpy × direct, {int(h)}×{int(w)}" for w, h in frames)]
-    body = []
-    for name in [*METHODS, "hardware"]:
-        cells = []
-        for frame in frames:
-            r = speed_row(rows, name, frame)
-            cells.append(f"{_f(r['gpu_ratio'])} (±{_f(r['gpu_spread'] * 50, 2)} %)" if r and _finite(r["gpu_ratio"])
-                         else "no kernel" if r else "–")
-        for frame in frames:
-            r = speed_row(rows, name, frame)
-            cells.append(r["numpy_ratio"] if r and _finite(r["numpy_ratio"]) else "–")
-        body.append([f"`{name}`", *cells])
-    return _table(header, body)
-
-
-def adaptive_table(rows) -> list[str]:
-    tilts = sorted({r["tilt_deg"] for r in select_rows(rows, sweep="tilt")})
-    header = ["tilt_deg", *(f"`{m}` px (exact/px)" for m in APPROXIMATIONS)]
-    body = [[_point("tilt_deg", t), *(f"{_f(_err(rows, 'tilt', m, tilt_deg=t))} "
-                                      f"({_f(_err(rows, 'tilt', m, 'exact_per_pixel', tilt_deg=t))})"
-                                      for m in APPROXIMATIONS)] for t in tilts]
-    return _table(header, body)
-
-
-def tile_table(rows) -> list[str]:
-    tiles = select_rows(rows, sweep="tile")
-    if not tiles:
-        return ["Not measured."]
-    points = sorted({(r["tilt_deg"], r["span_length"]) for r in tiles})
-    methods = ["direct", "incremental", "two_ended", "parallel_8", "kahan", *APPROXIMATIONS]
-    body = [[f"{t:g}", str(int(w)), *(_err(rows, "tile", m, tilt_deg=t, span_length=w) for m in methods)]
-            for t, w in points]
-    return _table(["tilt_deg", "span width", *(f"`{m}`" for m in methods)], body)
-
-
-def check_lines(rows) -> list[str]:
-    gpu = [r for r in rows if r["gpu_max_ulp"] is not None]
-    cpu = [r for r in rows if r["cpu_max_ulp"] is not None]
-    f64 = [r for r in rows if r["precision"] == "float64" and r["family"] == "paper" and r["tilt_deg"] < 90
-           and _finite(r["max_err"])]
-    ordinary = [r for r in f64 if r["span_length"] <= 1920 and r["tilt_deg"] <= 85 and r["offset_texels"] <= 1e3]
-    worst = max(f64, key=lambda r: r["max_err"], default=None)
-    undetected = sum(r["undetected"] for r in rows if r["undetected"] is not None)
-    return [
-        f"- GPU kernels against their numpy twins, {len(gpu)} method × configuration checks: largest difference "
-        f"{_f(float(max((r['gpu_max_ulp'] for r in gpu), default=float('nan'))))} ulp, "
-        f"{int(sum(r['gpu_flag_mismatch'] for r in gpu))} flag mismatches (0 and 0: bit for bit).",
-        f"- Compiled loops (scalar and SIMD builds) against their numpy twins, {len(cpu)} checks: largest difference "
-        f"{_f(float(max((r['cpu_max_ulp'] for r in cpu), default=float('nan'))))} ulp, "
-        f"{int(sum(r['cpu_flag_mismatch'] for r in cpu))} flag mismatches.",
-        f"- Float64 forms of the paper's formulas against the float64 reference (`direct`): at most "
-        f"{_f(max((r['max_err'] for r in ordinary), default=float('nan')))} texels on spans up to 1920 pixels, tilts "
-        f"up to 85° and offsets up to 1000 texels; the worst before the horizon "
-        + (f"{_f(worst['max_err'])} texels (`{worst['method']}`, L = {int(worst['span_length'])}, tilt "
-           f"{worst['tilt_deg']:g}°, offset {worst['offset_texels']:g}; {_f(worst['max_err_px'])} px)." if worst
-           else "–"),
-        f"- Pixels whose texel is undefined (behind the eye, on the horizon, |uv| > 2^24) that some method did not "
-        f"flag: {int(undetected)} over all rows.",
-    ]
-
-
-def tieback_table(relief: list[dict]) -> list[str]:
-    mags = sorted({r["magnitude_uv"] for r in relief})
-    techniques = list(dict.fromkeys(r["technique"] for r in relief))
-    header = ["uv magnitude (UV units)", "float32 spacing (texels)", *(f"`{t}`" for t in techniques)]
-    body = []
-    for m in mags:
-        row = [f"{m:g}", first_row(relief, magnitude_uv=m)["input_spacing_texels"]]
-        for t in techniques:
-            r = first_row(relief, technique=t, magnitude_uv=m)
-            row.append(r["p99_err"] if r else "")
-        body.append(row)
-    return _table(header, body)
-
-
 #: The report's title (harness.header).
 TITLE = "Perspective-correct texturing: speed against float error (Romanyuk & Dudnyk)"
 
@@ -536,11 +341,16 @@ PLOTS = {
 }
 
 
-def report_text(rows: list[dict], relief: list[dict], meta: dict, plotted: bool) -> str:
-    suite = meta["suite"]
-    speed = select_rows(rows, sweep="speed")
-    timer = speed[0]["timer"] if speed else "–"
-    gpu = gpu_label(meta["software"])
+def sweep_section(rows, sweep: str, key: str, pixel_sets: list[list[str]], texels: list[str]) -> list[str]:
+    """A sweep's tables: worst pixel's error in screen pixels for each set of methods, then in texels."""
+    lines = ["Screen pixels:", ""]
+    for methods in pixel_sets:
+        lines += [*sweep_table(rows, sweep, key, methods), ""]
+    return [*lines, "Texels:", "", *sweep_table(rows, sweep, key, texels, value="max_err")]
+
+
+def _preamble(meta: dict) -> list[str]:
+    """The header, the CPU, what a software adapter's times mean, and what the errors are."""
     lines = [
         *meta["header"].lines(),
         f"- CPU: {meta['cpu']} · Python {meta['python']}, numpy {meta['numpy']}, numba {meta['numba']} · "
@@ -558,18 +368,13 @@ def report_text(rows: list[dict], relief: list[dict], meta: dict, plotted: bool)
         "texture's scale matters. Every configuration's texel density gives its frame's middle pixel a footprint of "
         "one texel. Method, sweeps and caveats: `docs/perspective.md`.",
         "",
-        "## Recommendation",
-        "",
-        *recommendation(rows),
-        "",
-        "## Answers",
-        "",
-        *(f"- {a}" for a in answers(rows, suite, meta["software"])),
-        "",
-        "## Checks",
-        "",
-        *check_lines(rows),
-        "",
+    ]
+    return lines
+
+
+def _loop_sections(rows: list[dict], suite) -> list[str]:
+    """The compiled CPU loops, the operation counts, adaptive against fixed subdivision and the tile spans."""
+    return [
         "## Compiled CPU loops (numba): the paper's platform",
         "",
         "Each method as a loop over spans and pixels in float32 (the IEEE operations of its numpy twin, bit for "
@@ -604,32 +409,43 @@ def report_text(rows: list[dict], relief: list[dict], meta: dict, plotted: bool)
         "",
         *tile_table(rows),
         "",
+    ]
+
+
+def report_text(rows: list[dict], relief: list[dict], meta: dict, plotted: bool) -> str:
+    suite = meta["suite"]
+    speed = select_rows(rows, sweep="speed")
+    timer = speed[0]["timer"] if speed else "–"
+    gpu = gpu_label(meta["software"])
+    lines = [
+        *_preamble(meta),
+        "## Recommendation",
+        "",
+        *recommendation(rows),
+        "",
+        "## Answers",
+        "",
+        *(f"- {a}" for a in answers(rows, suite, meta["software"])),
+        "",
+        "## Checks",
+        "",
+        *check_lines(rows),
+        "",
+        *_loop_sections(rows, suite),
         f"## Error against span length (worst pixel; tilt {rows_tilt(rows)}°, offset 0, a texel per pixel at the "
         "frame's middle)",
         "",
-        "Screen pixels:",
-        "",
-        *sweep_table(rows, "span_length", "span_length", PAPER_F32 + RECIPROCAL + APPROXIMATIONS + ["hardware"]),
-        "",
-        *sweep_table(rows, "span_length", "span_length", ["incremental", *MITIGATIONS]),
-        "",
-        "Texels:",
-        "",
-        *sweep_table(rows, "span_length", "span_length", ["direct", "incremental", "parallel_32", "two_ended",
-                                                          "subdivided_16", "adaptive_8", "kahan", "hardware"],
-                     value="max_err"),
+        *sweep_section(rows, "span_length", "span_length",
+                       [PAPER_F32 + RECIPROCAL + APPROXIMATIONS + ["hardware"], ["incremental", *MITIGATIONS]],
+                       ["direct", "incremental", "parallel_32", "two_ended", "subdivided_16", "adaptive_8", "kahan",
+                        "hardware"]),
         "",
         f"## Error against tilt (worst pixel; L = {suite.sweep_span}; 90° = edge-on at the far end; beyond: past "
         "the horizon, those pixels flagged and left out)",
         "",
-        "Screen pixels:",
-        "",
-        *sweep_table(rows, "tilt", "tilt_deg", PAPER_F32 + RECIPROCAL + APPROXIMATIONS + ["hardware"]),
-        "",
-        "Texels:",
-        "",
-        *sweep_table(rows, "tilt", "tilt_deg", ["direct", "incremental", "parallel_32", "two_ended", "subdivided_16",
-                                                "adaptive_8", "kahan", "hardware"], value="max_err"),
+        *sweep_section(rows, "tilt", "tilt_deg", [PAPER_F32 + RECIPROCAL + APPROXIMATIONS + ["hardware"]],
+                       ["direct", "incremental", "parallel_32", "two_ended", "subdivided_16", "adaptive_8", "kahan",
+                        "hardware"]),
         "",
         "Flagged fraction per tilt (`direct`, `incremental`):",
         "",
@@ -637,16 +453,9 @@ def report_text(rows: list[dict], relief: list[dict], meta: dict, plotted: bool)
         "",
         f"## Error against texture-coordinate offset (worst pixel; L = {suite.sweep_span})",
         "",
-        "Screen pixels:",
-        "",
-        *sweep_table(rows, "magnitude", "offset_texels", PAPER_F32 + ["hardware"]),
-        "",
-        *sweep_table(rows, "magnitude", "offset_texels", ["incremental", *RECIPROCAL, *APPROXIMATIONS, *MITIGATIONS]),
-        "",
-        "Texels:",
-        "",
-        *sweep_table(rows, "magnitude", "offset_texels", ["direct", "incremental", "kahan", "fixed16_16", "hardware"],
-                     value="max_err"),
+        *sweep_section(rows, "magnitude", "offset_texels",
+                       [PAPER_F32 + ["hardware"], ["incremental", *RECIPROCAL, *APPROXIMATIONS, *MITIGATIONS]],
+                       ["direct", "incremental", "kahan", "fixed16_16", "hardware"]),
         "",
         f"## Timing on the {gpu}, and numpy's",
         "",

@@ -36,7 +36,7 @@ import numpy as np
 from wgpuviewer.core.io import write_bytes
 from wgpuviewer.lab.harness import suite as harness_suite
 from wgpuviewer.lab.harness.header import Clock
-from wgpuviewer.lab.harness.table import Column, Table
+from wgpuviewer.lab.harness.table import Column, Table, columns
 
 from . import tieback
 from .geometry import Quad, Reference, Setup, Spans, at_footprint, build, reference, tiles_of
@@ -91,6 +91,13 @@ SUITES = harness_suite.suites(
                   relief_magnitudes=(0.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7), relief_rays=4096, relief_texels=128),
 )
 
+def _timed(name: str, unit: str, ratio_unit: str = "x direct") -> tuple[Column, ...]:
+    """A timing's columns: ``name`` (PREFIX_ns or PREFIX_ms, the median), PREFIX_ratio and PREFIX_spread."""
+    prefix = name.rpartition("_")[0]
+    return (Column(name, float, unit), Column(f"{prefix}_ratio", float, ratio_unit),
+            Column(f"{prefix}_spread", float, "interquartile range / median"))
+
+
 #: results.csv: one row per sweep configuration x method x precision. A cell that does not apply to the row (the
 #: GPU time outside the speed sweep, the kernel check of a method's second precision) is empty.
 TABLE = Table("perspective results", (
@@ -98,19 +105,14 @@ TABLE = Table("perspective results", (
     Column("precision", str), Column("span_length", int, "pixels"), Column("spans", int),
     Column("tilt_deg", float, "degrees at the span's far end"), Column("offset_texels", float, "texels"),
     Column("coord_max_texels", float, "texels"), Column("footprint_texels", float, "texels per pixel, median"),
-    Column("max_err_px", float, "screen pixels"), Column("p99_err_px", float, "screen pixels"),
-    Column("mean_err_px", float, "screen pixels"), Column("max_err", float, "texels"), Column("p99_err", float, "texels"),
-    Column("mean_err", float, "texels"), Column("flagged_fraction", float, "of the pixels"),
+    *columns(float, "screen pixels", "max_err_px", "p99_err_px", "mean_err_px"),
+    *columns(float, "texels", "max_err", "p99_err", "mean_err"), Column("flagged_fraction", float, "of the pixels"),
     Column("undetected", int, "pixels"), Column("exact_per_pixel", float, "divided evaluations per pixel"),
-    Column("gpu_max_ulp", int, "float32 ulp"), Column("gpu_flag_mismatch", int, "pixels"),
-    Column("cpu_max_ulp", int, "float32 ulp"), Column("cpu_flag_mismatch", int, "pixels"),
-    Column("scalar_ns", float, "ns per texel, median"), Column("scalar_ratio", float, "x direct"),
-    Column("scalar_spread", float, "interquartile range / median"), Column("simd_ns", float, "ns per texel, median"),
-    Column("simd_ratio", float, "x direct (SIMD build)"), Column("simd_spread", float, "interquartile range / median"),
-    Column("simd_vectorised", str, "what LLVM made of the loop"),
-    Column("gpu_ms", float, "ms, median"), Column("gpu_ratio", float, "x direct"),
-    Column("gpu_spread", float, "interquartile range / median"), Column("numpy_ms", float, "ms, median"),
-    Column("numpy_ratio", float, "x direct"),
+    *(c for side in ("gpu", "cpu") for c in (Column(f"{side}_max_ulp", int, "float32 ulp"),
+                                             Column(f"{side}_flag_mismatch", int, "pixels"))),
+    *_timed("scalar_ns", "ns per texel, median"), *_timed("simd_ns", "ns per texel, median", "x direct (SIMD build)"),
+    Column("simd_vectorised", str, "what LLVM made of the loop"), *_timed("gpu_ms", "ms, median"),
+    *_timed("numpy_ms", "ms, median")[:2],
     *(Column(f"{kind}_per_texel", float, "operations") for kind in ("adds", "muls", "divs", "sqrts", "guards",
                                                                     "int_adds")),
     *(Column(f"fma_{kind}_per_texel", float, "operations with fused multiply-add") for kind in ("adds", "muls",
@@ -328,9 +330,9 @@ class Measurements:
         """Compiled CPU, GPU and numpy time of every method's first precision on one frame, with its errors there.
 
         The compiled loops of each build take turns in one run (``compiled.time_loops``); all kernels and the
-        rasteriser's pass take turns in another (core.timing): timestamp queries on hardware adapters, wall clock
+        rasteriser's pass take turns in another (core.pass_timing): timestamp queries on hardware adapters, wall clock
         net of an empty pass on software ones (whose compute timestamps are unreliable)."""
-        from wgpuviewer.core.timing import time_passes
+        from wgpuviewer.core.pass_timing import time_passes
 
         from .compiled import time_loops
         from .hardware import frame_recorder, hardware_uv, renderer_for

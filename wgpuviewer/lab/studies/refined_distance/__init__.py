@@ -6,7 +6,7 @@ and build time of every map format (``wgpuviewer refined-distance``; benchmarks/
 
 - ``command``: the command and its options (``STUDY``);
 - ``baseline``: the plain map of maptools version 2, the baseline the others are measured against;
-- ``tracer``: a float64 numpy twin of ``wgsl/techniques/distance.wgsl``'s sphere-step / cell-solve loop (same
+- ``tracer``: a float64 numpy twin of ``wgpuviewer/techniques/distance/distance.wgsl``'s sphere-step / cell-solve loop (same
   steps, same fetch counts);
 - ``reliefs``: the generated perforated plate and slot grille;
 - ``donnelly``: a float64 model of Donnelly's loop (fixed iterations, trilinear lookups, no finish);

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from maptools.distance import STORE_MARGIN, round_down
+from maptools.volume.cpu import STORE_MARGIN, round_down
 
 
 def _gdt_axis(f: np.ndarray, step: float) -> np.ndarray:

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from wgpuviewer.core.cli import comma_list, comma_numbers
+from wgpuviewer.core.commands import comma_list
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.lab.harness.study import add_measurement_options
+from wgpuviewer.lab.harness.study import StudyCommand, numbers_within
 
 from . import reliefs
 
@@ -14,16 +12,8 @@ from . import reliefs
 MAX_ANGLE = 89.0
 
 
-class RefinedDistance:
-    name = "refined-distance"
-    help = ("fetches of the distance tracer on every distance-map variant (Romanyuk et al. 2017, refined distance "
-            "map; its visibility condition off and on), Donnelly's fixed budgets, memory and build time of every map "
-            "format (results.csv, donnelly.csv, formats.csv, format_costs.csv, report.md)")
-
-    def add_arguments(self, parser) -> None:
-        add_measurement_options(parser, "output folder (results.csv, report.md)",
-                                "smoke: two small maps, two angles; full: the benchmark's real maps, its builtins, "
-                                "the generated plate and grille, 0-89 degrees")
+class RefinedDistance(StudyCommand):
+    def add_options(self, parser) -> None:
         parser.add_argument("--heightmaps", help="comma-separated: builtins, scikit-image brick,grass,gravel and/or "
                                                  "the generated " + ",".join(reliefs.NAMES))
         parser.add_argument("--angles", help=f"comma-separated view angles at the frame centre, degrees (0 to "
@@ -33,23 +23,19 @@ class RefinedDistance:
         """``run.run``'s keyword arguments, each option checked."""
         from wgpuviewer.lab.bench.run import check_heightmaps
 
-        angles = comma_numbers(args.angles, "--angles", "45,89")
-        if angles is not None and not all(0.0 <= a <= MAX_ANGLE for a in angles):
-            raise UserError(f"--angles {args.angles!r}: expected degrees from 0 to {MAX_ANGLE:g}")
+        angles = numbers_within(args.angles, "--angles", "45,89", 0.0, MAX_ANGLE)
         heightmaps = comma_list(args.heightmaps, "--heightmaps")
         try:
             check_heightmaps([h for h in heightmaps or [] if h not in reliefs.NAMES])
         except UserError as e:
             raise UserError(f"{e}, {', '.join(reliefs.NAMES)}") from None
-        return {"suite_name": args.suite, "heightmaps": heightmaps, "angles": angles, "backend": args.backend,
-                "progress": not args.quiet, "command": args.command_line}
-
-    def run(self, options: dict, out: Path) -> int:
-        from .run import run
-
-        run(out=out, **options)
-        print(out / "report.md")
-        return 0
+        return {**self.shared_options(args), "heightmaps": heightmaps, "angles": angles}
 
 
-STUDY = RefinedDistance()
+STUDY = RefinedDistance(
+    "refined-distance", "fetches of the distance tracer on every distance-map variant (Romanyuk et al. 2017, refined "
+    "distance map; its visibility condition off and on), Donnelly's fixed budgets, memory and build time of every map "
+    "format (results.csv, donnelly.csv, formats.csv, format_costs.csv, report.md)",
+    "output folder (results.csv, report.md)",
+    "smoke: two small maps, two angles; full: the benchmark's real maps, its builtins, the generated plate and "
+    "grille, 0-89 degrees")

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maptools.refined import volume_index
+from maptools.kinds.distance_refined.bins import volume_index
 
 #: A point reached past the exact hit by more than this along the ray (texels) has gone through the surface.
 PASS_TOLERANCE = 0.5

@@ -13,9 +13,12 @@ from dataclasses import dataclass
 import numpy as np
 
 import maptools
+from maptools.kinds.cone.slot import CONE_FILTER, CONE_MAX_RATIO, footprint_min_depth
+from maptools.kinds.distance_refined.slot import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
+from maptools.kinds.maxmip.slot import cell_max_height, maxmip_atlas, quadmax_atlas
+from maptools.volume.slot import uploaded_volume
 from wgpuviewer.lab.bench.view import HEIGHT_SCALE
-from wgpuviewer.relief.maps import cell_max_height, footprint_min_depth, maxmip_atlas, quadmax_atlas, uploaded_volume, volume_plan
-from wgpuviewer.techniques import CONE_FILTER, CONE_MAX_RATIO, REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
+from wgpuviewer.relief.maps import volume_plan
 
 FORMATS = ("distance", "distance_refined", "cone", "maxmip", "quadmax")
 BACKENDS = ("gpu", "cpu")

@@ -8,112 +8,27 @@ every auxiliary map format (formats.py). Variants no technique binds are traced 
 
 from __future__ import annotations
 
-import math
 import tempfile
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from maptools.cache import cached_generate
-from maptools.registry import get_kind
+from maptools.volume.slot import DISTANCE_SLICES
 from wgpuviewer.core.io import write_bytes
 from wgpuviewer.lab.harness import suite as harness_suite
 from wgpuviewer.lab.harness.header import Clock, Header
-from wgpuviewer.lab.harness.plots import MISSING, pyplot, save_png
 from wgpuviewer.lab.harness.table import Column, Table
 from wgpuviewer.relief.accuracy import simd_tile_cost
-from wgpuviewer.relief.maps import DISTANCE_SLICES, depth_range, uploaded_volume
-from wgpuviewer.techniques import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
+from wgpuviewer.relief.maps import depth_range
 
 from . import donnelly, formats, pits, reliefs
 from .baseline import plain_before
+from .report import PLOT, Results, plot, report
 from .tracer import trace
-
-#: The baseline's kind: not a maptools kind, built by baseline.plain_before (uncached: seconds).
-BEFORE = "maptools-2 plain"
-
-
-@dataclass(frozen=True)
-class Variant:
-    name: str
-    kind: str  # maptools kind
-    options: dict  # beyond slices and height_scale
-    technique: str = ""  # the registered technique that renders exactly this map, if any
-    storage: str = ""  # a compact storage of the values (STORAGES), "" as maptools stores them
-
-    def bins(self) -> dict:
-        """The tracer's view of the map: sectors, bands and max_angle (refined kind) or nothing (plain)."""
-        if self.kind != "distance_refined":
-            return {}
-        return {k: self.options[k] for k in ("sectors", "bands", "max_angle")}
-
-
-#: Donnelly stored his distances in 8 bits: over [0, EIGHT_BIT_RANGE] texels, larger ones stored as the range.
-EIGHT_BIT_RANGE = 16.0
-
-
-def _eight_bit(v: np.ndarray) -> np.ndarray:
-    v = np.asarray(v, np.float64)
-    return np.minimum(np.floor(np.minimum(v, EIGHT_BIT_RANGE) / EIGHT_BIT_RANGE * 255.0) * EIGHT_BIT_RANGE / 255.0, v)
-
-
-#: Storages of the plain map: each value rounded DOWN to what the storage holds (a step never grows, so safety
-#: holds), and its bytes per value: float16 (r16float, what the renderer uploads: relief.maps.uploaded_volume) and
-#: Donnelly's 8 bits (r8unorm); maptools' own float32 is the variant without a storage.
-STORAGES = {"float16": (lambda v: uploaded_volume(v).astype(np.float64), 2), "8-bit": (_eight_bit, 1)}
-
-#: The paper's visibility condition as maptools names it (an option of the distance_refined kind).
-VISIBILITY = "visibility"
-
-
-def _refined(sectors: int, bands: int, technique: str = "", visibility: str = "") -> Variant:
-    """A refined-map variant; ``visibility`` "on"/"off" sets the paper's condition, "" leaves the kind's default."""
-    name = "single cone" if sectors == bands == 1 else f"{sectors} sectors x {bands} bands"
-    options = {"sectors": sectors, "bands": bands, "max_angle": REFINED_MAX_ANGLE}
-    if visibility:
-        name += f", visibility {visibility}"
-        options[VISIBILITY] = visibility
-    return Variant(name, "distance_refined", options, technique)
-
-
-VARIANTS = (
-    Variant("plain before (maptools-2)", BEFORE, {}),
-    Variant("plain K=1", "distance", {"subcells": 1}),
-    Variant("plain K=4", "distance", {"subcells": 4}, "distance", storage="float16"),
-    Variant("plain K=4, float32", "distance", {"subcells": 4}),
-    Variant("plain K=4, 8-bit", "distance", {"subcells": 4}, storage="8-bit"),
-    _refined(1, 1),
-    _refined(8, 1),
-    _refined(1, REFINED_BANDS),
-    _refined(2, REFINED_BANDS),
-    _refined(REFINED_SECTORS, REFINED_BANDS, "distance_refined"),
-    _refined(1, 1, visibility="on"),
-    _refined(REFINED_SECTORS, REFINED_BANDS, visibility="on"),
-)
-PRODUCT = VARIANTS[-3].name
-SINGLE_CONE = next(v.name for v in VARIANTS if v.kind == "distance_refined")
-PLAIN = "plain K=4"  # the product's `distance` map: the ratios' denominator
-#: The paper's condition: (its map with the condition, the same map without), single cone and binned.
-CONDITION_PAIRS = ((VARIANTS[-2].name, SINGLE_CONE), (VARIANTS[-1].name, PRODUCT))
-
-
-def variants() -> tuple[Variant, ...]:
-    """The variants measured: every refined one with its condition set ("off" where VARIANTS leaves it out), and
-    the `distance_refined` technique on the product's bins with the kind's default condition (what the renderer
-    builds)."""
-    default = next(o.default for o in get_kind("distance_refined").options if o.name == VISIBILITY)
-    out = []
-    for v in VARIANTS:
-        if v.kind != "distance_refined":
-            out.append(v)
-            continue
-        opts = {VISIBILITY: "off", **v.options}
-        product_bins = (opts["sectors"], opts["bands"]) == (REFINED_SECTORS, REFINED_BANDS)
-        technique = "distance_refined" if product_bins and opts[VISIBILITY] == default else ""
-        out.append(replace(v, options=opts, technique=technique))
-    return tuple(out)
+from .variants import BEFORE, DONNELLY_VARIANTS, STORAGES, Variant, variants
 
 
 @dataclass(frozen=True)
@@ -186,10 +101,6 @@ COSTS_TABLE = Table("refined-distance format costs", (
 #: The report's title (harness.header).
 TITLE = "Distance-map variants: fetches per pixel (mean / SIMD-tile 8x4)"
 
-#: Donnelly's regime is measured on these variants (those this maptools builds).
-#: The plain map in maptools' float32 and in Donnelly's 8 bits (the product's is float16: PLAIN).
-OTHER_STORAGES = ("plain K=4, float32", "plain K=4, 8-bit")
-DONNELLY_VARIANTS = (PLAIN, SINGLE_CONE, VARIANTS[-2].name, PRODUCT, VARIANTS[-1].name, *OTHER_STORAGES)
 
 
 def _build(variant: Variant, height: np.ndarray, height_scale: float) -> tuple[np.ndarray, float, int]:
@@ -213,14 +124,6 @@ def load(name: str, size: int, workdir: Path):
 
     return reliefs.load(name, size, workdir) if name in reliefs.NAMES else load_heightmap(name, size, workdir)
 
-
-@dataclass
-class Results:
-    rows: list[dict]
-    donnelly: list[dict]
-    formats: list[dict]
-    costs: list[dict]
-    pits: list[dict]
 
 
 def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str | None = None,
@@ -367,7 +270,7 @@ FORMAT_TECHNIQUES = {"distance": "distance", "distance_refined": "distance_refin
 
 def _costs(heightmap, suite: Suite, gpu) -> list[dict]:
     """Per map format, the GPU renderer's fetches (mean, SIMD-tile), capped pixels and frame time at each angle."""
-    from wgpuviewer.lab.bench.timing import time_configs
+    from wgpuviewer.lab.bench.config_timing import time_configs
     from wgpuviewer.lab.bench.view import make_view
     from wgpuviewer.relief.renderer import DrawConfig, Renderer
 
@@ -387,9 +290,6 @@ def _costs(heightmap, suite: Suite, gpu) -> list[dict]:
     return rows
 
 
-#: Files of a run (a stale one from an earlier layout is removed by the lead, not here).
-PLOT = "ratio_to_distance.png"
-
 
 def _write(out: Path, res: Results, header: Header) -> None:
     """The CSV files, the picture and report.md of the results so far (rewritten after each part)."""
@@ -401,223 +301,3 @@ def _write(out: Path, res: Results, header: Header) -> None:
         pits.TABLE.write(out / "pits.csv", res.pits)
     plotted = plot(res.rows, out / PLOT)
     write_bytes(out / "report.md", report(res, header, plotted).encode())
-
-
-def _twins(rows: list[dict]) -> list[dict]:
-    return [r for r in rows if r["tracer"] == "numpy twin"]
-
-
-def ratios(rows: list[dict], key: str = "fetches_mean") -> dict[tuple[str, str, float], float]:
-    """(height map, variant, angle) -> the variant's ``key`` over the plain K=4 map's (the `distance` technique's)
-    on the same view, numpy-twin rows."""
-    twins = _twins(rows)
-    plain = {(r["heightmap"], r["angle"]): r[key] for r in twins if r["variant"] == PLAIN}
-    return {(r["heightmap"], r["variant"], r["angle"]): r[key] / plain[r["heightmap"], r["angle"]]
-            for r in twins if (r["heightmap"], r["angle"]) in plain and plain[r["heightmap"], r["angle"]] > 0}
-
-
-def plot(rows: list[dict], path: Path) -> bool:
-    """Fetches per pixel over the `distance` map's (plain K=4) against the view angle: one panel per height map,
-    one line per variant; the visibility-on maps dashed in the colour of their visibility-off twin. False when
-    matplotlib is missing (the tables still stand)."""
-    with pyplot() as plt:
-        if plt is None:
-            return False
-        _draw(plt, rows, path)
-    return True
-
-
-def _draw(plt, rows: list[dict], path: Path) -> None:
-    by = ratios(rows)
-    maps = list(dict.fromkeys(k[0] for k in by))
-    cols = min(3, len(maps)) or 1
-    panel_rows = math.ceil(len(maps) / cols) or 1
-    fig, axes = plt.subplots(panel_rows, cols, figsize=(4.2 * cols, 3.2 * panel_rows), squeeze=False)
-    off_of = {on: off for on, off in CONDITION_PAIRS}
-    names = [v.name for v in VARIANTS if v.name != PLAIN]
-    colours = {n: plt.cm.tab10(i % 10) for i, n in enumerate(n for n in names if n not in off_of)}
-    sizes = {r["heightmap"]: r["size"] for r in rows}
-    for ax, name in zip(axes.ravel(), maps):
-        for variant in names:
-            mine = sorted((a, r) for (m, v, a), r in by.items() if m == name and v == variant)
-            if not mine:
-                continue
-            angles, ratio = zip(*mine)
-            on = variant in off_of
-            ax.plot(angles, ratio, "--" if on else "-", marker="x" if on else "o", ms=3,
-                    lw=2.0 if PRODUCT in variant else 1.1, color=colours[off_of.get(variant, variant)],
-                    label=variant)
-        ax.axhline(1.0, color="k", lw=0.6)
-        ax.set_title(f"{name} ({sizes[name]})", fontsize=9)
-        ax.set_xlabel("view angle at the frame centre (deg)", fontsize=7)
-        ax.set_ylabel("fetches / distance map's", fontsize=7)
-        ax.tick_params(labelsize=7)
-        ax.grid()
-    for ax in axes.ravel()[len(maps):]:
-        ax.axis("off")
-    handles, labels = axes.ravel()[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=min(4, len(labels)) or 1, fontsize=7, frameon=False)
-    fig.suptitle("Fetches to the exact hit over the `distance` map's (plain K=4), mean per pixel; "
-                 "dashed: the paper's visibility condition on", fontsize=9)
-    fig.tight_layout(rect=(0, 0.1, 1, 0.96))
-    save_png(fig, path, tight=False)
-
-
-#: The report's change columns: (label, variant, against which variant).
-CHANGES = (("K=4 vs before", PLAIN, VARIANTS[0].name), ("product vs before", PRODUCT, VARIANTS[0].name),
-           ("product vs K=4", PRODUCT, PLAIN),
-           *((f"K=4 {name.split(', ')[1]} vs float16", name, PLAIN) for name in OTHER_STORAGES))
-
-
-def _pct(a: float | None, b: float | None) -> str:
-    return "-" if not (a and b) else f"{100 * (a / b - 1):+.0f} %"
-
-
-def _change(by: dict, variant: str, base: str) -> str:
-    a, b = by.get(variant), by.get(base)
-    if not (a and b):
-        return "-"
-    return f"{_pct(a['fetches_mean'], b['fetches_mean'])} / {_pct(a['fetches_simd'], b['fetches_simd'])}"
-
-
-def report(res: Results, header: Header, plotted: bool) -> str:
-    """Markdown: the paper's condition (on vs off), per height map every variant's fetches by angle with the
-    changes, grazing views, Donnelly's regime, the map formats."""
-    lines = [*header.lines(), "",
-             "Every fetch to the final hit (volume fetches and exact-cell gathers), the same tracer (the numpy twin of "
-             "`distance.wgsl`) for every map; the GPU renderer beside it where a technique binds the map. Changes: "
-             "mean / SIMD-tile. " + (f"Picture (ratios to the `distance` map): [{PLOT}]({PLOT})." if plotted
-                                    else MISSING), ""]
-    lines += _condition_section(res.rows)
-    lines += pits.section(res.pits)
-    lines += _variant_sections(res.rows)
-    lines += _grazing_section(res.rows)
-    lines += _donnelly_section(res.donnelly)
-    lines += _formats_section(res.formats, res.costs)
-    return "\n".join(lines) + "\n"
-
-
-def _condition_section(rows: list[dict]) -> list[str]:
-    lines = ["## The paper's visibility condition", ""]
-    twins = _twins(rows)
-    lines += ["Fetches with the condition over the same map without it (mean / SIMD-tile), per view angle: "
-              "single cone (sectors 1 x bands 1, the paper's map) and the binned map (the product's bins).", "",
-              "| height map | angle | single cone: on vs off | binned: on vs off |", "|---|---|---|---|"]
-    by = {(r["heightmap"], r["angle"], r["variant"]): r for r in twins}
-    for name, angle in dict.fromkeys((r["heightmap"], r["angle"]) for r in twins):
-        cells = [_change({v: by.get((name, angle, v)) for v in pair}, *pair) for pair in CONDITION_PAIRS]
-        lines.append(f"| {name} | {angle:g}° | " + " | ".join(cells) + " |")
-    return lines + [""]
-
-
-def _variant_sections(rows: list[dict]) -> list[str]:
-    lines = []
-    present = dict.fromkeys(r["variant"] for r in _twins(rows))
-    names = [v.name for v in VARIANTS if v.name in present]
-    for name in dict.fromkeys(r["heightmap"] for r in rows):
-        mine = [r for r in _twins(rows) if r["heightmap"] == name]
-        if not mine:
-            continue
-        lines += [f"## {name} ({mine[0]['size']})", "",
-                  "| angle | " + " | ".join(names + [c[0] for c in CHANGES]) + " |",
-                  "|---|" + "---|" * (len(names) + len(CHANGES))]
-        for angle in dict.fromkeys(r["angle"] for r in mine):
-            cells, by = [], {r["variant"]: r for r in mine if r["angle"] == angle}
-            for v in names:
-                r = by.get(v)
-                cells.append(f"{r['fetches_mean']:.2f} / {r['fetches_simd']:.2f}" if r else "-")
-            cells += [_change(by, variant, base) for _, variant, base in CHANGES]
-            lines.append(f"| {angle:g}° | " + " | ".join(cells) + " |")
-        builds = {r["variant"]: r for r in mine}
-        lines += ["", "build (s, cache included) and memory (MiB): " + "; ".join(
-            f"{v}: {builds[v]['build_s']:.1f} s, {builds[v]['memory_mib']:.1f} MiB" for v in names if v in builds),
-            ""]
-        gpu = [r for r in rows if r["heightmap"] == name and r["tracer"] != "numpy twin"]
-        if gpu:
-            lines.append(f"GPU renderer ({gpu[0]['tracer']}), same views: " + "; ".join(
-                f"{r['variant']} {r['angle']:g}° {r['fetches_mean']:.2f} / {r['fetches_simd']:.2f}" for r in gpu))
-            lines.append("")
-    return lines
-
-
-#: Views at or beyond this angle are the grazing section's.
-GRAZING = 85.0
-
-
-def _grazing_section(rows: list[dict]) -> list[str]:
-    graze = [r for r in rows if r["angle"] >= GRAZING and r["variant"] in (PLAIN, PRODUCT)]
-    if not graze:
-        return []
-    lines = ["## Grazing views", "",
-             f"Fetches (mean / SIMD-tile) and the pixels the tracer's cap stopped (capped), at {GRAZING:g}° and "
-             f"beyond; rays past the refined map's {REFINED_MAX_ANGLE:g}° cone use its plain volume. The GPU rows "
-             "are the product as it is; the twin models the sphere-step / cell-solve loop alone, so a GPU row below "
-             "its twin is the product's own grazing finish at work.", "",
-             "| height map | angle | map | tracer | fetches | capped |", "|---|---|---|---|---|---|"]
-    for r in graze:
-        lines.append(f"| {r['heightmap']} | {r['angle']:g}° | {r['variant']} | {r['tracer']} | "
-                     f"{r['fetches_mean']:.2f} / {r['fetches_simd']:.2f} | {100 * r['capped']:.2f} % |")
-    return lines + [""]
-
-
-def _donnelly_section(rows: list[dict]) -> list[str]:
-    if not rows:
-        return []
-    budgets = sorted({r["iterations"] for r in rows if r["regime"] == "fixed"})
-    lines = ["## Donnelly's regime: fixed iterations, trilinear lookups, no finish", "",
-             "A float64 numpy model of Donnelly's loop (`studies/refined_distance/donnelly.py`): from the surface "
-             "plane, N steps of the trilinearly filtered stored distance, the point reached is the hit (no finish). "
-             "Error: |uv reached - uv of the float64 exact first hit| in texels, p95 / max; passed: rays whose point "
-             "lies past the exact hit (a trilinear blend of conservative voxels can step through the surface). "
-             "Exact: the product's tracer (the twin; its fetches include the exact cell gathers).", "",
-             "| height map | angle | map | " + " | ".join(f"N={n} p95 / max (passed)" for n in budgets) +
-             " | exact: fetches (p95 / max) |", "|---|---|---|" + "---|" * (len(budgets) + 1)]
-    keys = dict.fromkeys((r["heightmap"], r["angle"], r["variant"]) for r in rows)
-    for key in keys:
-        mine = {r["iterations"]: r for r in rows if (r["heightmap"], r["angle"], r["variant"]) == key}
-        cells = [f"{mine[n]['error_p95']:.2f} / {mine[n]['error_max']:.2f} ({100 * mine[n]['passed']:.1f} %)"
-                 if n in mine else "-" for n in budgets]
-        exact = mine.get(None)
-        cells.append(f"{exact['fetches_mean']:.1f} ({exact['error_p95']:.3f} / {exact['error_max']:.3f})"
-                     if exact else "-")
-        lines.append(f"| {key[0]} | {key[1]:g}° | {key[2]} | " + " | ".join(cells) + " |")
-    return lines + [""]
-
-
-def formats_markdown(built: list[dict], costs: list[dict]) -> list[str]:
-    """ONE table: per map format, bytes per texel, build time (GPU path / CPU reference) per size, and the GPU
-    renderer's fetches / SIMD-tile fetches / ms to the exact hit per angle (per height map of the costs)."""
-    sizes = sorted({b["size"] for b in built})
-    cost_keys = list(dict.fromkeys((c["heightmap"], c["angle"]) for c in costs))
-    head = (["format", "bytes / texel"] + [f"build {n}² GPU / CPU (s)" for n in sizes] +
-            [f"{m} {a:g}°: fetches / SIMD / ms" for m, a in cost_keys])
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for fmt in formats.FORMATS:
-        mine = [b for b in built if b["format"] == fmt]
-        if not mine:
-            continue
-        cells = [f"`{fmt}`", f"{mine[0]['bytes_per_texel']:.1f}"]
-        for n in sizes:
-            pair = []
-            for backend in formats.BACKENDS:
-                b = next((b for b in mine if b["size"] == n and b["backend"] == backend), None)
-                pair.append("-" if b is None else f"{'~' if b['extrapolated'] else ''}{b['build_s']:.2f}")
-            cells.append(" / ".join(pair))
-        for m, a in cost_keys:
-            c = next((c for c in costs if (c["heightmap"], c["angle"], c["format"]) == (m, a, fmt)), None)
-            cells.append("-" if c is None else f"{c['fetches_mean']:.1f} / {c['fetches_simd']:.1f} / {c['ms']:.2f}")
-        lines.append("| " + " | ".join(cells) + " |")
-    return lines
-
-
-def _formats_section(built: list[dict], costs: list[dict]) -> list[str]:
-    if not built:
-        return []
-    settings = "; ".join(dict.fromkeys(f"`{b['format']}` {b['settings']}" for b in built if b["size"] ==
-                                       max(x["size"] for x in built) and b["backend"] == "gpu"))
-    return ["## Map formats: memory, build time, cost to the exact hit", "",
-            "Bytes per height-map texel of the texture(s) the renderer uploads; build time uncached, GPU path / CPU "
-            "reference (~: not run, extrapolated in proportion to the texels from the largest size measured within "
-            "the suite's budget); fetches (mean / SIMD-tile 8x4) and median ms per frame of the format's technique "
-            "in the GPU renderer (on a software adapter only the fetches and the ms ratios mean anything). "
-            f"Settings at the largest size: {settings}.", "", *formats_markdown(built, costs), ""]

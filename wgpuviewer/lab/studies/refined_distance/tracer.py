@@ -1,4 +1,4 @@
-"""A float64 numpy twin of the distance tracer (``wgsl/techniques/distance.wgsl``), for measuring map variants that
+"""A float64 numpy twin of the distance tracer (``wgpuviewer/techniques/distance/distance.wgsl``), for measuring map variants that
 no registered technique binds (a single cone, sectors without bands, K = 1 sub-cells) on the very rays the renderer
 traces. It takes the same steps and counts the same fetches (tests/lab/studies checks it against the GPU probe): per
 iteration one volume fetch; a sphere step when it leaves the current bilinear cell, else the exact solve of that cell
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maptools.refined import volume_index
+from maptools.kinds.distance_refined.bins import volume_index
 from wgpuviewer.relief.reference import cell_root
 
 

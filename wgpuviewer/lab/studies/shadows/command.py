@@ -2,22 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from wgpuviewer.core.cli import comma_list, comma_numbers
+from wgpuviewer.core.commands import comma_list
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.lab.harness.study import add_measurement_options
+from wgpuviewer.lab.harness.study import StudyCommand, numbers_within
 
 
-class Shadows:
-    name = "shadows"
-    help = ("self-shadowing of every ray-search technique against the float64 reference: wrong hard-shadow states, "
-            "soft-shadow difference, shadow-ray fetches (results.csv, report.md, shadows.png)")
-
-    def add_arguments(self, parser) -> None:
-        add_measurement_options(parser, "output folder (results.csv, report.md, shadows.png)",
-                                "smoke: two small maps, two techniques, 30 and 60 degrees; full: the benchmark's maps, "
-                                "every ray-search technique, 30-80 degrees")
+class Shadows(StudyCommand):
+    def add_options(self, parser) -> None:
         parser.add_argument("--heightmaps", help="comma-separated builtins and/or scikit-image brick,grass,gravel")
         parser.add_argument("--techniques", help="comma-separated ray-search techniques (default: the suite's)")
         parser.add_argument("--elevations", help="comma-separated light elevations above the surface, degrees "
@@ -29,9 +20,7 @@ class Shadows:
         from wgpuviewer.relief.accuracy import shadowing_techniques
         from wgpuviewer.techniques import get_technique
 
-        elevations = comma_numbers(args.elevations, "--elevations", "30,80")
-        if elevations is not None and not all(0.0 < e <= 90.0 for e in elevations):
-            raise UserError(f"--elevations {args.elevations!r}: expected degrees above 0 and at most 90")
+        elevations = numbers_within(args.elevations, "--elevations", "30,80", 0.0, 90.0, above_low=True)
         heightmaps = comma_list(args.heightmaps, "--heightmaps")
         check_heightmaps(heightmaps or [])
         techniques = comma_list(args.techniques, "--techniques")
@@ -42,16 +31,13 @@ class Shadows:
             if other:
                 raise UserError(f"--techniques: {', '.join(other)} cast no shadow of their own (no search along the "
                                 f"ray); expected some of {', '.join(allowed)}")
-        return {"suite_name": args.suite, "heightmaps": heightmaps, "techniques": techniques,
-                "elevations": elevations, "backend": args.backend, "progress": not args.quiet,
-                "command": args.command_line}
-
-    def run(self, options: dict, out: Path) -> int:
-        from .run import run
-
-        run(out=out, **options)
-        print(out / "report.md")
-        return 0
+        return {**self.shared_options(args), "heightmaps": heightmaps, "techniques": techniques,
+                "elevations": elevations}
 
 
-STUDY = Shadows()
+STUDY = Shadows(
+    "shadows", "self-shadowing of every ray-search technique against the float64 reference: wrong hard-shadow "
+    "states, soft-shadow difference, shadow-ray fetches (results.csv, report.md, shadows.png)",
+    "output folder (results.csv, report.md, shadows.png)",
+    "smoke: two small maps, two techniques, 30 and 60 degrees; full: the benchmark's maps, every ray-search "
+    "technique, 30-80 degrees")

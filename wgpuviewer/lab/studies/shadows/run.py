@@ -5,7 +5,7 @@ pixels are) at VIEW_ANGLE from the normal. Each ray's exact first hit (``referen
 directional light at each elevation (azimuth LIGHT_AZIMUTH from the view's): its float64 shadow
 (``reference.shadow``) is the truth. Per technique the GPU shadow (``probe.shadow_probe``: the renderer's WGSL) is
 taken twice: at the exact hit (the shadow ray's own error) and at the technique's own view hit (``probe.probe``; what
-the renderer draws: both rays' errors). Timing (``relief.timing``): frames of a brick floor, open and half hidden
+the renderer draws: both rays' errors). Timing (``relief.draw_timing``): frames of a brick floor, open and half hidden
 behind a wall drawn first, with shadows off, hard, soft and ``depth_offset`` on drawn side by side (the draw's
 overrides, round robin).
 """
@@ -26,8 +26,8 @@ from wgpuviewer.lab.harness.plots import MISSING, pyplot, save_png
 from wgpuviewer.lab.harness.table import Column, Table
 from wgpuviewer.relief import reference as ref
 from wgpuviewer.relief.accuracy import LIGHT_AZIMUTH, measure_shadows, shadowing_techniques, simd_tile_cost
+from wgpuviewer.relief.draw_timing import time_draws
 from wgpuviewer.relief.renderer import Renderer
-from wgpuviewer.relief.timing import time_draws
 from wgpuviewer.scene import parse_scene
 
 TITLE = "Self-shadowing: hard and soft shadows of every ray-search technique against the float64 reference"
@@ -115,7 +115,7 @@ position = [0.0, 0.6, 1.0]"""
 
 def timing(gpu, suite: Suite) -> list[dict]:
     """Frame times per scene (open, occluded) and technique of every TIMING_VARIANTS draw, round robin in one renderer
-    (``relief.timing``), as ratios to the plain draw. Writing the hit's depth (depth_offset) turns off early depth
+    (``relief.draw_timing``), as ratios to the plain draw. Writing the hit's depth (depth_offset) turns off early depth
     testing: behind the wall the floor's fragments then run their whole search before the depth test drops them."""
     rows = []
     for scene_name, objects in (("open", FLOOR), ("occluded", OCCLUDER + "\n" + FLOOR)):
@@ -243,7 +243,7 @@ def report(header: Header, rows: list[dict], picture: str | None, suite: Suite, 
         f"{m} {np.mean([r['ref_lit'] for r in rows if r['heightmap'] == m]):.0%}" for m in maps) + "."]
     hidden = max(r["hidden"] for r in times)
     lines += ["", f"Frame times of the default scene's brick floor at {suite.timing_size[0]}x{suite.timing_size[1]} "
-              f"(`relief.timing`, median of {suite.timing_frames} frames, the variants drawn round robin), open and "
+              f"(`relief.draw_timing`, median of {suite.timing_frames} frames, the variants drawn round robin), open and "
               f"with a wall drawn first that hides {hidden:.0%} of it, as ratios to the same scene and technique's "
               "plain draw:", "",
               "| scene | technique | " + " | ".join(TIMING_VARIANTS) + " |", "|---|---|" + "---|" * len(TIMING_VARIANTS)]
