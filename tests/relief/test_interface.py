@@ -16,7 +16,7 @@ from tests.relief.scenes import plane_scene
 from tests.relief.technique_folder import technique_folder
 from wgpuviewer.core.structs import FragmentOutputs
 from wgpuviewer.core.wgsl import read_wgsl
-from wgpuviewer.relief import filter_probe, maps, probe, renderer, shaders
+from wgpuviewer.relief import filter_probe, maps, probe, shaders, targets
 from wgpuviewer.relief.maps import MAP_SLOTS
 from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.scene import parse_scene
@@ -25,7 +25,7 @@ from wgpuviewer.viewer import error_view
 
 #: Every entry file and the records Python generates for it (composed in before it: the entry never declares them).
 ENTRY_RECORDS = {
-    "entry/render.wgsl": (shaders.FRAME, shaders.OBJECT, renderer.DATA_OUT),
+    "entry/render.wgsl": (shaders.FRAME, shaders.OBJECT, targets.DATA_OUT),
     "entry/probe.wgsl": (probe.PROBE_RAY, probe.PROBE_HIT),
     "entry/filter_probe.wgsl": (filter_probe.FILTER_SAMPLE, filter_probe.FILTER_OUT),
     "entry/gradient_probe.wgsl": (filter_probe.GRADIENT_SAMPLE, filter_probe.GRADIENT_VALUE),
@@ -54,10 +54,10 @@ def test_entry_files_declare_no_generated_record(entry):
 def test_data_out_is_generated_from_the_offscreen_targets():
     """fs_data's outputs and the offscreen formats are one list: location = position, each type fit for its
     format (WebGPU's sample type and channel rule, refused by name otherwise)."""
-    assert renderer.OFFSCREEN_FORMATS == renderer.DATA_OUT.formats == (
-        renderer.COLOR_FORMAT, renderer.DATA_FORMAT, renderer.LAYERS_FORMAT, renderer.FILTER_FORMAT,
-        renderer.VIEW_DEPTH_FORMAT)
-    assert renderer.DATA_OUT.wgsl() == ("struct DataOut {\n    @location(0) color: vec4f,\n"
+    assert targets.OFFSCREEN_FORMATS == targets.DATA_OUT.formats == (
+        targets.COLOR_FORMAT, targets.DATA_FORMAT, targets.LAYERS_FORMAT, targets.FILTER_FORMAT,
+        targets.VIEW_DEPTH_FORMAT)
+    assert targets.DATA_OUT.wgsl() == ("struct DataOut {\n    @location(0) color: vec4f,\n"
                                         "    @location(1) data: vec4u,\n    @location(2) layers: u32,\n"
                                         "    @location(3) filtering: vec4u,\n    @location(4) view_depth: u32,\n}\n")
     FragmentOutputs("Fine", [("a", "vec4f", "bgra8unorm-srgb"), ("b", "vec2i", "rg16sint"), ("c", "u32", "r8uint")])

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from wgpuviewer.relief.output import mode_data, mode_picture
-from wgpuviewer.relief.renderer import OFFSCREEN_FORMATS, Renderer
+from wgpuviewer.relief.renderer import Renderer
+from wgpuviewer.relief.targets import OFFSCREEN_FORMATS
 from wgpuviewer.scene import default_scene_path, load_scene
 from wgpuviewer.techniques import TECHNIQUES
 

@@ -18,7 +18,8 @@ from wgpuviewer.core import gpu as core_gpu
 from wgpuviewer.core.compute import Compute
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import format_bytes
-from wgpuviewer.relief.renderer import Renderer, frame_bytes
+from wgpuviewer.relief.renderer import Renderer
+from wgpuviewer.relief.targets import frame_bytes
 from wgpuviewer.scene import parse_scene
 
 
@@ -88,7 +89,7 @@ def scene(height: str, techniques=("pom",)) -> str:
 def test_the_largest_render_size_beyond_the_adapter_is_refused_naming_size_at_once(gpu, capsys, tmp_path):
     """The QA case: 16384x16384 is inside --size's range; where its targets cannot be read back, it is refused
     before any map is built, not an internal error."""
-    from wgpuviewer.relief.renderer import readback_bytes
+    from wgpuviewer.relief.targets import readback_bytes
 
     if readback_bytes(16384, 16384, "rgba32uint") <= gpu.device.limits["max-buffer-size"]:
         pytest.skip("this adapter reads back a 16384x16384 frame")
@@ -102,7 +103,7 @@ def test_the_largest_render_size_beyond_the_adapter_is_refused_naming_size_at_on
 
 def test_a_frame_beyond_the_largest_buffer_is_refused_before_any_map_is_built(gpu, capsys, tmp_path, monkeypatch,
                                                                            no_builtins):
-    from wgpuviewer.relief.renderer import check_frame_size
+    from wgpuviewer.relief.targets import check_frame_size
 
     small = other_gpu(gpu, limits={"max-buffer-size": 2**20})
     monkeypatch.setattr(core_gpu, "get_gpu", lambda *a, **k: small)

@@ -10,7 +10,8 @@ import pytest
 
 from tests.relief.scenes import material_scene
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.relief.renderer import Renderer, offset_fraction
+from wgpuviewer.relief.renderer import Renderer
+from wgpuviewer.relief.uniforms import offset_fraction
 from wgpuviewer.scene import parse_scene
 
 TEXELS = 64

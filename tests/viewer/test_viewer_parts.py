@@ -160,7 +160,7 @@ def test_error_overlay_paints_heat_and_keeps_uncovered_pixels(gpu):
 
 
 def test_gpu_timer_reads_back_pass_times_without_blocking(gpu, scene):
-    from wgpuviewer.relief.renderer import COLOR_FORMAT, DEPTH_FORMAT
+    from wgpuviewer.relief.targets import COLOR_FORMAT, DEPTH_FORMAT
     from wgpuviewer.viewer.stats import GpuTimer
 
     if not GpuTimer.available(gpu):

@@ -41,34 +41,15 @@ from .filters import (
 )
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range
 from .material_textures import depth_data, derived_texture, height_size, material_texture, reported_against
-from .pipelines import Pipelines, fragment_entry, module
+from .pipelines import Pipelines, module
 from .shaders import FRAME, PLAIN, MaterialVariant, pack_trace_params, trace_params_size, traces_relief
 from .targets import (
-    COLOR_FORMAT,
-    DATA_FORMAT,
-    DATA_OUT,
-    DEPTH_FORMAT,
-    FILTER_FORMAT,
-    LAYERS_FORMAT,
     OFFSCREEN_FORMATS,
-    SMALLER_FRAME,
-    VIEW_DEPTH_FORMAT,
-    FrameError,
     OffscreenFrame,
     OffscreenImage,
     check_frame_size,
-    frame_bytes,
-    readback_bytes,
 )
-from .uniforms import MODES, frame_data, object_data, offset_fraction, scene_lights
-
-#: The renderer's names, and what it draws into and with (``targets``, ``uniforms``, ``pipelines``), from here.
-__all__ = [
-    "COLOR_FORMAT", "DATA_FORMAT", "DATA_OUT", "DEPTH_FORMAT", "FILTER_FORMAT", "LAYERS_FORMAT", "MAX_DRAW_GROUPS",
-    "MODES", "OFFSCREEN_FORMATS", "SMALLER_FRAME", "VIEW_DEPTH_FORMAT", "DrawConfig", "FrameError", "OffscreenImage",
-    "Renderer", "check_frame_size", "fragment_entry", "frame_bytes", "offset_fraction", "readback_bytes",
-    "scene_lights",
-]
+from .uniforms import frame_data, object_data, scene_lights
 
 #: Draw configurations whose uniform buffer and bind group are kept per material (the least recently drawn are
 #: dropped): draws with different parameters can share one submit (the A/B split, the benchmark's batched frames).

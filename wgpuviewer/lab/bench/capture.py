@@ -12,7 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 import wgpu
 
-from wgpuviewer.relief.renderer import COLOR_FORMAT, DATA_FORMAT, DEPTH_FORMAT, LAYERS_FORMAT, DrawConfig, Renderer
+from wgpuviewer.relief.renderer import DrawConfig, Renderer
+from wgpuviewer.relief.targets import COLOR_FORMAT, DATA_FORMAT, DEPTH_FORMAT, LAYERS_FORMAT
 
 #: Most bytes one batch reads back (colour + data targets of its configurations).
 MAX_BATCH_BYTES = 256 << 20

@@ -12,7 +12,8 @@ import numpy as np
 import wgpu
 
 from wgpuviewer.core.gpu import Gpu
-from wgpuviewer.relief.renderer import COLOR_FORMAT, DEPTH_FORMAT, DrawConfig, Renderer
+from wgpuviewer.relief.renderer import DrawConfig, Renderer
+from wgpuviewer.relief.targets import COLOR_FORMAT, DEPTH_FORMAT
 from wgpuviewer.scene import parse_scene
 
 from .geometry import Quad, scene_toml
