@@ -53,6 +53,12 @@ def list_adapters() -> list[wgpu.GPUAdapter]:
     return list(wgpu.gpu.enumerate_adapters_sync())
 
 
+def offered_backends(adapters: list[wgpu.GPUAdapter] | None = None) -> list[str]:
+    """The backend names (``BACKENDS``' keys) this machine has adapters for, in ``BACKENDS``' order."""
+    kinds = {a.info.get("backend_type") for a in (list_adapters() if adapters is None else adapters)}
+    return [name for name, kind in BACKENDS.items() if kind in kinds]
+
+
 def is_software(adapter: wgpu.GPUAdapter) -> bool:
     return adapter.info.get("adapter_type") == "CPU"
 
@@ -61,8 +67,12 @@ def choose_adapter(backend: str | None = None, *, quiet: bool = False) -> wgpu.G
     """The adapter for a backend name; raises NoAdapterError with the fix when there is none."""
     name = resolve_backend(backend)
     adapters = list_adapters()
+    offered = offered_backends(adapters)
     if name != "auto":
         adapters = [a for a in adapters if a.info.get("backend_type") == BACKENDS[name]]
+    if not adapters and offered:  # another backend would do
+        raise NoAdapterError(f"no GPU adapter found for backend {name!r} (this machine offers "
+                             f"{', '.join(offered)}); use --backend {offered[0]} or --backend auto")
     if not adapters:
         where = "" if name == "auto" else f" for backend {name!r}"
         raise NoAdapterError(f"no GPU adapter found{where}; {NO_ADAPTER_FIX}")
@@ -125,6 +135,7 @@ def describe_adapters(backend: str | None = None) -> str:
     if not adapters:
         lines.append(f"  (none) -- {NO_ADAPTER_FIX}")
         return "\n".join(lines)
+    lines.append(f"backends: {', '.join(offered_backends(adapters))}")
     chosen = choose_adapter(backend, quiet=True)
     lines.append(f"chosen ({resolve_backend(backend)}): {chosen.summary}")
     have = sorted(f for f in WANTED_FEATURES if f in chosen.features)

@@ -47,7 +47,7 @@ from .keys import PRESSED, TECHNIQUE_KEYS
 from .settings import LIMITS, Settings, save_session
 from .state import Half, ViewerState
 from .stats import FrameStats, GpuTimer, Summary, half_summaries, split_column
-from .window import Window, toolkit
+from .window import Window, prepare_gpu, toolkit
 
 MODES = ("color", "cost", "error")
 
@@ -73,6 +73,7 @@ class Viewer:
         self.settings = settings or Settings()
         s = self.settings
         self.scene = scene
+        prepare_gpu(gui)  # before the first adapter request: the window's surface must work with its adapter
         self.gpu = get_gpu(backend)
         self.renderer = Renderer(scene, self.gpu)
         # What the first technique needs is built before the window opens (a bad file: one line, exit 2).

@@ -5,13 +5,16 @@ a time, ``W:0.5``, takes as many frames as ``keys.parse_script`` gives it), the 
 ``screenshot``; an ERROR logged while drawing makes the run exit 1, an error inside a frame ends it (exit 2 for a
 UserError). A key that closes the window (Escape) ends the script: no frame is drawn once the window is closing, even
 when the toolkit asks for one more, a run closed before its last frame says so (and writes no screenshot), and a map
-build under way stops before the run returns.
+build under way stops before the run returns. A window that gives no frame to draw into (wgpu-py cancels the frame:
+a surface lost for good, a zero-size window) ends a scripted run after ``STALL_FRAMES`` cancelled frames and
+``STALL_SECONDS``, with one line (exit 2), instead of waiting forever; an interactive run waits (a minimised window).
 """
 
 from __future__ import annotations
 
 import logging
 import sys
+import time
 from pathlib import Path
 
 import wgpu
@@ -24,6 +27,9 @@ from .keys import parse_script
 
 #: The loggers whose ERRORs fail a scripted run.
 LOGGERS = ("wgpu", "rendercanvas")
+#: A scripted run ends when this many frames in a row were cancelled over at least this long since the last drawn.
+STALL_FRAMES = 30
+STALL_SECONDS = 10.0
 
 
 def scripted_frames(frames: int | None, screenshot: str | None, keys) -> int | None:
@@ -50,10 +56,16 @@ class _ErrorLogCounter(logging.Handler):
         self.count += 1
 
 
+def _stalled(state: dict) -> bool:
+    """Count a cancelled frame; whether the window has given none for STALL_FRAMES tries and STALL_SECONDS."""
+    state["cancelled"] += 1
+    return state["cancelled"] >= STALL_FRAMES and time.perf_counter() - state["drawn_at"] >= STALL_SECONDS
+
+
 def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=()) -> int:
     """Draw ``viewer`` in its window until it closes (interactive: ``frames`` None) or for ``frames`` frames,
     playing the ``--keys`` items ``keys``."""
-    state = {"frame": 0}
+    state = {"frame": 0, "cancelled": 0, "drawn_at": time.perf_counter()}
     pending = parse_script(keys)
     window = viewer.window
     # rendercanvas only logs a failing draw and shows the previous frame: a scripted run must
@@ -74,12 +86,18 @@ def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=(
                 raise wgpu.DrawCancelled("the window is closing")
             texture = viewer.draw()
             state["frame"] += 1
+            state["cancelled"], state["drawn_at"] = 0, time.perf_counter()
             if frames is not None and state["frame"] >= frames:
                 if screenshot:
                     save_rgb_png(Path(screenshot), viewer.read_frame(texture))
                     print(screenshot)
                 window.close()
-        except wgpu.DrawCancelled:
+        except wgpu.DrawCancelled as cancelled:
+            if frames is not None and not window.closed and _stalled(state):
+                state["error"] = UserError(
+                    f"the window gave no frame to draw into ({cancelled}) for {state['cancelled']} tries in a row; "
+                    "try another --backend, or render offscreen (view without a display, or wgpuviewer render)")
+                window.close()
             raise  # the toolkit skips this frame
         except BaseException as error:
             # rendercanvas would log it and call us again forever: stop, and report it after the loop.

@@ -1,13 +1,29 @@
 """The window, behind one adapter: the toolkit choice (glfw by default, Qt on request), the rendercanvas canvas and
 its wgpu surface, events, the title, vsync and fullscreen.
 
-Every toolkit-specific call and every reach into a rendercanvas/wgpu private lives here, so that a rendercanvas
-release that moves one breaks this module alone (and vsync or fullscreen fail as a message, never the viewer).
+Every toolkit-specific call and every reach into a rendercanvas private lives here, so that a rendercanvas release
+that moves one breaks this module alone (and vsync or fullscreen fail as a message, never the viewer); the wgpu-native
+ones (the instance a window presents from, the surface check) live in ``core.window_instance``.
+
+A window opens only on an adapter that can present to it (``Window._check_surface``): configuring a surface the
+adapter cannot use is a wgpu-native panic, which aborts the process, so that case is one line instead (``refusal``:
+the backend, why, and the backends and the offscreen render that work). A surface whose textures cannot be read back
+(OpenGL's: no COPY_SRC) gets frames drawn into a texture of the window's own, copied onto it (``Present``).
 """
 
 from __future__ import annotations
 
+import wgpu
+
+from wgpuviewer.core import window_instance
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.gpu import BACKENDS, list_adapters
+from wgpuviewer.core.wgsl import compose
+
+#: wgpu's backend_type -> the --backend name.
+BACKEND_NAMES = {kind: name for name, kind in BACKENDS.items()}
+#: What the window's frames are used for: drawn into, and read back (scripted runs, P).
+FRAME_USAGE = wgpu.TextureUsage.RENDER_ATTACHMENT | wgpu.TextureUsage.COPY_SRC
 
 
 def toolkit(gui: str):
@@ -36,6 +52,28 @@ def toolkit(gui: str):
     return RenderCanvas, loop
 
 
+def prepare_gpu(gui: str) -> None:
+    """Call before the window's GPU starts (before any adapter request): a glfw window on X11 needs wgpu's instance
+    to know glfw's display, or OpenGL adapters cannot present to it (``core.window_instance``)."""
+    if gui == "glfw":
+        window_instance.prepare_instance_for_glfw()
+
+
+def refusal(adapter, problem: str, context) -> UserError:
+    """One line: the backend cannot present to this window, why, and what works instead (the backends whose
+    adapters can present to this window, and rendering offscreen)."""
+    name = BACKEND_NAMES.get(adapter.info.get("backend_type"), adapter.info.get("backend_type"))
+    working = []
+    for other in list_adapters():
+        other_name = BACKEND_NAMES.get(other.info.get("backend_type"))
+        caps = window_instance.surface_capabilities(context, other) if other_name not in (None, name) else None
+        if caps is not None and caps.problem is None and other_name not in working:
+            working.append(other_name)
+    instead = "".join(f"--backend {n}, or " for n in working)
+    return UserError(f"the {name} backend cannot present to this window ({adapter.summary}: {problem}); use "
+                     f"{instead}render offscreen (wgpuviewer render --backend {name}, or view without a display)")
+
+
 class Window:
     """A rendercanvas window drawing with ``gpu``'s device; ``canvas`` is the rendercanvas object (for the HUD)."""
 
@@ -47,21 +85,54 @@ class Window:
             title="wgpuviewer", size=size, update_mode="continuous", max_fps=1000 if scripted else 240, vsync=vsync,
         )
         self.context = self.canvas.get_wgpu_context()
+        #: None: frames are the surface's own textures; else they are drawn into a texture of the window's own and
+        #: copied onto the surface (``Present``), where the surface's cannot be read back.
+        self._present = None
+        self._surface_usage = self._check_surface(gpu)
         self.format = self.context.get_preferred_format(gpu.adapter)
+        if self._surface_usage != FRAME_USAGE:
+            self._present = Present(self._device, self.format)
         self._windowed = ((100, 100), size)  # where leaving fullscreen puts the window
         self._closing = False
         self._closing_handlers = []
         self.canvas.add_event_handler(self._on_canvas_close, "close")
         self._configure()
 
+    def _check_surface(self, gpu) -> int:
+        """The usage to configure the surface with; a UserError (the window closed) when ``gpu``'s adapter cannot
+        present to it: configuring it would be a wgpu-native panic, which aborts the process."""
+        if getattr(self.context, "_wgpu_context", None) is None:
+            return FRAME_USAGE  # rendercanvas presents a bitmap (jupyter): textures of its own, no native surface
+        caps = window_instance.surface_capabilities(self.context, gpu.adapter)
+        problem = caps.problem if caps is not None else None
+        if gpu.adapter.info.get("backend_type") == "OpenGL" and not window_instance.display_given():
+            if caps is None:  # unknown: configuring would be a gamble with a panic
+                problem = "this wgpu-py offers no way to check or prepare its surface"
+            elif problem:
+                problem += " (the GPU started before the window's display was known)"
+        if problem:
+            error = refusal(gpu.adapter, problem, self.context)
+            self._release_surface()
+            self.canvas.close()
+            raise error
+        if caps is not None and caps.usages & FRAME_USAGE == FRAME_USAGE:
+            return FRAME_USAGE  # scripted runs and P read back the frame just drawn
+        return wgpu.TextureUsage.RENDER_ATTACHMENT  # always allowed on a surface the adapter can present to
+
     def _configure(self):
-        # COPY_SRC lets scripted runs and P read back the frame just drawn.
-        self.context.configure(device=self._device, format=self.format, usage="RENDER_ATTACHMENT|COPY_SRC")
+        self.context.configure(device=self._device, format=self.format, usage=self._surface_usage)
 
     def on(self, handler, *event_types: str) -> None:
         self.canvas.add_event_handler(handler, *event_types)
 
     def current_texture(self):
+        """The texture to draw this frame into (it can be read back); a zero-size window (minimised) cancels the
+        frame (wgpu-py refuses a texture with zero pixels)."""
+        w, h = self.canvas.get_physical_size()
+        if w < 1 or h < 1:
+            raise wgpu.DrawCancelled("zero-sized frame")
+        if self._present is not None:
+            return self._present.frame((w, h))
         return self.context.get_current_texture()
 
     def logical_size(self) -> tuple[float, float]:
@@ -74,7 +145,15 @@ class Window:
         self.canvas.set_title(title)
 
     def request_draw(self, draw) -> None:
-        self.canvas.request_draw(draw)
+        if self._present is None:
+            self.canvas.request_draw(draw)
+            return
+
+        def draw_and_copy():
+            draw()
+            self._present.copy(self.context.get_current_texture())
+
+        self.canvas.request_draw(draw_and_copy)
 
     def run(self) -> None:
         """The event loop, until the window closes."""
@@ -152,3 +231,49 @@ class Window:
         except Exception as error:  # noqa: BLE001 -- e.g. no monitor, or another toolkit
             return f"not available here ({error})"
         return None
+
+
+class Present:
+    """Frames drawn into a texture of the window's own (which can be read back), copied onto the surface's texture
+    by a fullscreen pass (``wgsl/entry/present.wgsl``): for surfaces without COPY_SRC (OpenGL's)."""
+
+    def __init__(self, device, format: str):
+        self.device = device
+        module = device.create_shader_module(label="present", code=compose("entry/present.wgsl").code)
+        self.layout = device.create_bind_group_layout(label="present", entries=[
+            {"binding": 0, "visibility": wgpu.ShaderStage.FRAGMENT, "texture": {"sample_type": "unfilterable-float"}},
+        ])
+        self.pipeline = device.create_render_pipeline(
+            label="present",
+            layout=device.create_pipeline_layout(label="present", bind_group_layouts=[self.layout]),
+            vertex={"module": module, "entry_point": "vs_main"},
+            primitive={"topology": "triangle-list"},
+            fragment={"module": module, "entry_point": "fs_main", "targets": [{"format": format}]},
+        )
+        self.format = format
+        self.texture = None
+        self.group = None
+
+    def frame(self, size: tuple[int, int]):
+        """The texture to draw a frame of ``size`` into."""
+        if self.texture is None or self.texture.size[:2] != size:
+            self.texture = self.device.create_texture(
+                label="window:frame", size=(*size, 1), format=self.format,
+                usage=FRAME_USAGE | wgpu.TextureUsage.TEXTURE_BINDING,
+            )
+            self.group = self.device.create_bind_group(
+                layout=self.layout, entries=[{"binding": 0, "resource": self.texture.create_view()}])
+        return self.texture
+
+    def copy(self, target) -> None:
+        """Copy the frame just drawn onto ``target``, the surface's texture."""
+        if self.group is None:
+            return
+        encoder = self.device.create_command_encoder(label="present")
+        rpass = encoder.begin_render_pass(label="present", color_attachments=[
+            {"view": target.create_view(), "load_op": "clear", "store_op": "store", "clear_value": (0, 0, 0, 1)}])
+        rpass.set_pipeline(self.pipeline)
+        rpass.set_bind_group(0, self.group)
+        rpass.draw(3)
+        rpass.end()
+        self.device.queue.submit([encoder.finish()])
