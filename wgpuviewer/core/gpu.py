@@ -304,3 +304,19 @@ class MipChain:
 def mip_chain(data: np.ndarray) -> MipChain:
     """The (lazy) mip chain of ``data``: see ``MipChain``."""
     return MipChain(data)
+
+
+def fullscreen_pipeline(device: wgpu.GPUDevice, label: str, code: str, entries: list[dict],
+                        target_format: str) -> tuple[wgpu.GPUBindGroupLayout, wgpu.GPURenderPipeline]:
+    """(bind-group layout, pipeline) of a fullscreen pass: ``code`` includes ``common/fullscreen.wgsl`` (its
+    ``vs_main``, draw 3 vertices) and defines ``fs_main``; ``entries``: the layout entries of @group(0)."""
+    module = device.create_shader_module(label=label, code=code)
+    layout = device.create_bind_group_layout(label=label, entries=entries)
+    pipeline = device.create_render_pipeline(
+        label=label,
+        layout=device.create_pipeline_layout(label=label, bind_group_layouts=[layout]),
+        vertex={"module": module, "entry_point": "vs_main"},
+        primitive={"topology": "triangle-list"},
+        fragment={"module": module, "entry_point": "fs_main", "targets": [{"format": target_format}]},
+    )
+    return layout, pipeline

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import wgpu
 
+from wgpuviewer.core.gpu import fullscreen_pipeline
 from wgpuviewer.core.structs import Struct
 from wgpuviewer.core.wgsl import compose
 from wgpuviewer.relief.reference import uv_error_texels
@@ -76,22 +77,12 @@ class ErrorOverlay:
 
     def __init__(self, device: wgpu.GPUDevice, target_format: str):
         self.device = device
-        code = compose(BLIT.generated(), "entry/error_view.wgsl").code
-        module = device.create_shader_module(label="error-view", code=code)
         F = wgpu.ShaderStage.FRAGMENT
-        self.layout = device.create_bind_group_layout(
-            label="error-view",
-            entries=[
-                {"binding": 0, "visibility": F, "buffer": {"type": "uniform"}},
-                {"binding": 1, "visibility": F, "texture": {"sample_type": "unfilterable-float"}},
-            ],
-        )
-        self.pipeline = device.create_render_pipeline(
-            label="error-view",
-            layout=device.create_pipeline_layout(label="error-view", bind_group_layouts=[self.layout]),
-            vertex={"module": module, "entry_point": "vs_main"},
-            primitive={"topology": "triangle-list"},
-            fragment={"module": module, "entry_point": "fs_main", "targets": [{"format": target_format}]},
+        self.layout, self.pipeline = fullscreen_pipeline(
+            device, "error-view", compose(BLIT.generated(), "entry/error_view.wgsl").code,
+            [{"binding": 0, "visibility": F, "buffer": {"type": "uniform"}},
+             {"binding": 1, "visibility": F, "texture": {"sample_type": "unfilterable-float"}}],
+            target_format,
         )
         self.texture = None
         self.group = None

@@ -17,7 +17,7 @@ import wgpu
 
 from wgpuviewer.core import window_instance
 from wgpuviewer.core.errors import UserError
-from wgpuviewer.core.gpu import BACKENDS, list_adapters
+from wgpuviewer.core.gpu import BACKENDS, fullscreen_pipeline, list_adapters
 from wgpuviewer.core.wgsl import compose
 
 #: wgpu's backend_type -> the --backend name.
@@ -239,16 +239,10 @@ class Present:
 
     def __init__(self, device, format: str):
         self.device = device
-        module = device.create_shader_module(label="present", code=compose("entry/present.wgsl").code)
-        self.layout = device.create_bind_group_layout(label="present", entries=[
-            {"binding": 0, "visibility": wgpu.ShaderStage.FRAGMENT, "texture": {"sample_type": "unfilterable-float"}},
-        ])
-        self.pipeline = device.create_render_pipeline(
-            label="present",
-            layout=device.create_pipeline_layout(label="present", bind_group_layouts=[self.layout]),
-            vertex={"module": module, "entry_point": "vs_main"},
-            primitive={"topology": "triangle-list"},
-            fragment={"module": module, "entry_point": "fs_main", "targets": [{"format": format}]},
+        self.layout, self.pipeline = fullscreen_pipeline(
+            device, "present", compose("entry/present.wgsl").code,
+            [{"binding": 0, "visibility": wgpu.ShaderStage.FRAGMENT, "texture": {"sample_type": "unfilterable-float"}}],
+            format,
         )
         self.format = format
         self.texture = None

@@ -2,15 +2,10 @@
 // over part of the frame with the cost view's heat ramp; negative values keep the frame underneath.
 // Blit is generated from wgpuviewer/viewer/error_view.py (BLIT).
 // #include "common/heat.wgsl"
+// #include "common/fullscreen.wgsl"
 
 @group(0) @binding(0) var<uniform> blit: Blit;
 @group(0) @binding(1) var values: texture_2d<f32>;
-
-@vertex
-fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
-    let p = vec2f(f32((i << 1u) & 2u), f32(i & 2u));  // fullscreen triangle
-    return vec4f(p * 2.0 - 1.0, 0.0, 1.0);
-}
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {

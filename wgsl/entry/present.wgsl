@@ -1,14 +1,9 @@
 // The viewer's present copy (wgpuviewer/viewer/window.py): where a window's surface cannot be read back (OpenGL
 // surfaces offer no COPY_SRC), the viewer draws each frame into a texture of its own and this fullscreen pass
 // copies it, texel for texel, onto the surface's texture.
+// #include "common/fullscreen.wgsl"
 
 @group(0) @binding(0) var frame: texture_2d<f32>;
-
-@vertex
-fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
-    let p = vec2f(f32((i << 1u) & 2u), f32(i & 2u));  // fullscreen triangle
-    return vec4f(p * 2.0 - 1.0, 0.0, 1.0);
-}
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
