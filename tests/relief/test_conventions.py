@@ -19,13 +19,9 @@ from wgpuviewer.relief.renderer import Renderer
 from wgpuviewer.scene import load_scene
 
 SCENE = """
-[scene]
-techniques = ["normal", "pom"]
-[camera]
-position = [0.0, 2.0, 0.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 0.0, -1.0]   # screen up = -Z = towards v = 0, so screen rows follow texture rows
-fov = 40
+scene = {{ techniques = ["normal", "pom"] }}
+# screen up = -Z = towards v = 0, so screen rows follow texture rows
+camera = {{ position = [0.0, 2.0, 0.0], target = [0.0, 0.0, 0.0], up = [0.0, 0.0, -1.0], fov = 40 }}
 [[lights]]
 type = "directional"
 direction = {direction}

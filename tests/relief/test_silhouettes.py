@@ -17,12 +17,8 @@ SIZE = (96, 72)
 def scene(address: str, kind: str) -> str:
     size = "[1.0, 1.0]" if kind == "quad" else "[1.0, 1.0, 1.0]"
     return f"""
-[scene]
-techniques = ["maxmip", "basic"]
-[camera]
-position = [1.1, 0.8, 1.6]
-target = [0.0, 0.0, 0.0]
-fov = 60
+scene = {{ techniques = ["maxmip", "basic"] }}
+camera = {{ position = [1.1, 0.8, 1.6], target = [0.0, 0.0, 0.0], fov = 60 }}
 [materials.m]
 albedo = [0.8, 0.8, 0.8]
 height = {{ builtin = "bricks", size = [64, 64] }}
