@@ -10,15 +10,16 @@ From Python (``api``; docs/usage.md)::
 
 - ``core/``: errors, GPU, atomic I/O, the image reader, CPU sampling, colour, the WGSL composer (imports nothing
   else of the project);
-- ``scene.py``, ``textures.py``, ``meshes.py``, ``camera.py``: scenes and what they are made of;
+- ``scene/``, ``textures.py``, ``meshes/``, ``camera.py``: scenes and what they are made of;
 - ``techniques/``: the technique registry and one folder per technique, found without a list;
 - ``relief/``: maps, shaders, renderer, probe, float64 reference, accuracy;
-- ``viewer/``, ``bench/``, ``studies/``: the window, the benchmark, the studies (each imported only by ``cli``,
-  the viewer also by ``api``'s ``view``);
-- ``api.py``: ``render``, ``view``, ``CameraSpec`` (exported here), and the camera and relief settings the
-  ``render`` command shares with them;
+- ``viewer/``: the window (imported by ``cli`` and by ``api``'s ``view``);
+- ``api.py``: ``render``, ``view``, ``CameraSpec`` (exported here) and ``prepare``, the one path of a render, which
+  the ``render`` command takes too;
+- ``cli.py``, ``cli_render.py``: the ``wgpuviewer`` command;
 - ``probe.py``, ``reference.py``, ``accuracy.py``: the documented API, re-exported from ``relief/``;
-- ``gpusuite.py``: ``./dev gpu-suite``, bench and the studies within one time budget, and the README's headline.
+- ``lab/``: the harness, bench, the studies, ``./dev gpu-suite`` and ``wgpuviewer docs`` (only ``cli`` reaches in;
+  the product never imports the lab).
 
 The scene modules may import ``core`` and ``techniques`` (scenes name techniques and their parameters).
 This package imports ``api`` on first use of a name it exports, so importing any module of it (``core.commands``,

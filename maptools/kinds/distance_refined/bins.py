@@ -80,7 +80,7 @@ def bins(sectors: int, bands: int, max_angle: float) -> list[Bin]:
 
 def volume_index(view_dir, sectors: int, bands: int, max_angle: float) -> np.ndarray:
     """The volume a ray with tangent-space view vector V (N, 3), V.z > 0, reads, decided as the tracer
-    (wgsl/techniques/distance.wgsl) decides it: the plain volume (last) when it is steeper than max_angle, else its
+    (wgpuviewer/techniques/distance/distance.wgsl) decides it: the plain volume (last) when it is steeper than max_angle, else its
     bin: the sector of the azimuth of (-V.x, -V.y) (sector 0 for a vertical ray), the band
     floor(bands * ln cos(polar) / ln cos(max_angle))."""
     v = np.atleast_2d(np.asarray(view_dir, np.float64))

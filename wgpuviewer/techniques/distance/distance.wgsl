@@ -1,6 +1,6 @@
 // Distance-map parallax (Donnelly), shared by `distance` and `distance_refined`: the loop is the same, only the
 // texture bound at distance_tex differs. The plain map is one volume; the refined map (Romanyuk et al. 2017) is one
-// volume per bin of ray directions (azimuth sector x polar band, maptools/refined.py) and the plain volume last,
+// volume per bin of ray directions (azimuth sector x polar band, maptools/kinds/distance_refined/) and the plain volume last,
 // stacked along the texture's depth. A ray keeps its direction, so it picks its volume once: by the azimuth of its
 // horizontal direction and its polar angle, or the last (plain) volume when it is steeper than the binned cone.
 //
