@@ -3,10 +3,11 @@ by this explicit command (no measurement writes the checkout's pages).
 
 A block is the text between a ``<!-- generated: NAME -->`` line and the next ``<!-- end generated -->`` line; each
 (page, NAME) has one source in ``BLOCKS``: a registry's table (techniques, filters, map kinds, viewer keys) or a
-committed results folder (the README's headline from the newest ``./dev gpu-suite`` run under ``benchmarks/``,
-docs/filtering.md's numbers from ``benchmarks/filtering_lavapipe/``). A marker with no source, or a source whose
-marker is missing from its page, is an error: a block is never silently left alone. Pages are written atomically
-and only when a block changed; ``--check`` writes nothing and exits 1 naming every block that differs.
+committed results folder (the README's headline from the newest ``./dev gpu-suite`` run under ``benchmarks/``; each
+study folder's ``docs.py`` ``BLOCKS``, e.g. docs/filtering.md's numbers from ``benchmarks/filtering_lavapipe/``).
+A marker with no source, or a source whose marker is missing from its page, is an error: a block is never silently
+left alone. Pages are written atomically and only when a block changed; ``--check`` writes nothing and exits 1
+naming every block that differs.
 
 In the lab room: it may import anything of the product, bench, the harness and the studies (their report code is
 the source of their blocks).
@@ -14,20 +15,22 @@ the source of their blocks).
 
 from __future__ import annotations
 
+import importlib
+import importlib.util
+import pkgutil
 import re
 import sys
-from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import write_bytes
+from wgpuviewer.lab.harness.blocks import Block
+from wgpuviewer.lab.harness.study import STUDIES_PACKAGE
 
 CHECKOUT = Path(__file__).resolve().parents[2]
 BEGIN = "<!-- generated: {name} -->"
 END = "<!-- end generated -->"
 MARKER = re.compile(r"^<!-- generated: (.+?) -->$", re.MULTILINE)  # on a line of its own (not quoted in prose)
-FILTERING_RUN = "benchmarks/filtering_lavapipe"
 
 
 def _techniques(root: Path) -> str:
@@ -60,28 +63,25 @@ def _headline(root: Path) -> str:
     return headline_markdown(root / "benchmarks", root)
 
 
-def _filtering(root: Path) -> str:
-    from wgpuviewer.lab.studies.filtering.docs import docs_body_of
-
-    return docs_body_of(root / FILTERING_RUN)
-
-
-@dataclass(frozen=True)
-class Block:
-    page: str  # relative to the checkout
-    name: str  # the marker's NAME
-    source: str  # what it is generated from, in words
-    body: Callable[[Path], str]  # the checkout's root -> the text between the markers (without them)
-
-
-BLOCKS = (
+OWN_BLOCKS = (
     Block("README.md", "headline", "the newest ./dev gpu-suite run under benchmarks/", _headline),
     Block("README.md", "techniques", "the technique registry", _techniques),
     Block("README.md", "filters", "the filter registry", _filters),
     Block("README.md", "map kinds", "the map-kind registry", _map_kinds),
-    Block("docs/filtering.md", "filtering results", f"{FILTERING_RUN}/results.csv", _filtering),
     Block("docs/usage.md", "viewer keys", "the viewer's key table", _keys),
 )
+
+
+def study_blocks(package: str = STUDIES_PACKAGE) -> tuple[Block, ...]:
+    """``BLOCKS`` of every study folder's ``docs`` module (a study without one publishes no block)."""
+    found = []
+    for info in sorted(pkgutil.iter_modules(importlib.import_module(package).__path__), key=lambda m: m.name):
+        if info.ispkg and importlib.util.find_spec(f"{package}.{info.name}.docs") is not None:
+            found.extend(importlib.import_module(f"{package}.{info.name}.docs").BLOCKS)
+    return tuple(found)
+
+
+BLOCKS = OWN_BLOCKS + study_blocks()
 
 
 def pages(root: Path) -> list[Path]:

@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from wgpuviewer.lab.harness.blocks import Block
+
 from .report import derivative_sources, flicker, measures, recommendation, tuning, visibility, weighting
 from .suites import RUN_FILE, TABLE
 
@@ -41,3 +43,8 @@ def docs_body_of(folder: Path) -> str:
 def docs_block_of(folder: Path) -> str:
     """``docs_block`` of the run in ``folder``."""
     return f"{DOCS_BEGIN}\n{docs_body_of(folder)}\n{DOCS_END}"
+
+
+FILTERING_RUN = "benchmarks/filtering_lavapipe"
+BLOCKS = (Block("docs/filtering.md", "filtering results", f"{FILTERING_RUN}/results.csv",
+                lambda root: docs_body_of(root / FILTERING_RUN), results=FILTERING_RUN),)
