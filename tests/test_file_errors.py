@@ -137,3 +137,30 @@ def test_maptools_refuses_a_huge_declared_size_at_once(tmp_path, capsys):
     src = huge_npy(tmp_path / "huge.npy")
     assert maptools_cli.main(["generate", "normal", str(src), "-o", str(tmp_path / "n.png"), "--backend", "cpu"]) == 2
     assert one_line(capsys, "maptools").startswith(f"maptools: error: {src}: 60000x60000 is larger than the limit")
+
+
+def _loop(folder, a: str, b: str) -> None:
+    (folder / a).symlink_to(folder / b)
+    (folder / b).symlink_to(folder / a)
+
+
+@pytest.mark.parametrize("material, key, value", [
+    ('albedo = "loop.png"\nheight = "good.png"', "albedo", "loop.png"),
+    ('albedo = "good.png"\nfolder = "loopdir"', "folder", "loopdir"),
+    ('albedo = "good.png"\nheight = "good.png"\n[materials.m.maps]\ncone = "loop.png"', "maps.cone", "loop.png"),
+])
+def test_a_symbolic_link_loop_in_a_scene_path_is_one_line(files, capsys, material, key, value):
+    _loop(files, "loop.png", "loop2.png")
+    _loop(files, "loopdir", "loopdir2")
+    path = files / "s.toml"
+    path.write_text(material_scene(["basic"], material))
+    assert cli.main(["render", str(path), "-o", str(files / "out.png"), "--size", "16x16"]) == 2
+    line = one_line(capsys)
+    assert f"{path}: materials.m.{key} = '{value}': symbolic link loop" in line, line
+
+
+def test_a_symbolic_link_loop_as_the_material_folder_is_one_line(files, capsys):
+    _loop(files, "loopdir", "loopdir2")
+    assert cli.main(["render", "--material", str(files / "loopdir"), "-o", str(files / "out.png"), "--size", "16x16"]) == 2
+    line = one_line(capsys)
+    assert f"--material {files / 'loopdir'}: symbolic link loop" in line, line

@@ -1,11 +1,16 @@
 """Hostile glTF files (wgpuviewer.meshes.gltf_document, gltf_accessors): every count, offset, stride and index is
 checked before an accessor is decoded, and JSON values of the wrong type are named by their key. Each case is one
-FileError line naming the file and the key, never a crash, a read outside the buffer or an internal error."""
+FileError line naming the file and the key, never a crash, a read outside the buffer or an internal error.
+
+And what valid glTF may hold: KHR_texture_transform (applied to the uvs), a node of scale 0 (its triangles left out),
+a material the scene replaces (not read); transforms that push triangles beyond float32 are named as such."""
 
 from __future__ import annotations
 
 import base64
 import json
+import logging
+import os
 import struct
 import tempfile
 import tracemalloc
@@ -122,6 +127,8 @@ def test_a_node_cycle_is_refused(tmp_path):
     (setter("nodes", 0, "translation", [1, 2]), ["nodes[0].translation = [1, 2]: expected an array of 3 numbers"]),
     (setter("nodes", 0, "children", 3), ["nodes[0].children = 3: expected an array"]),
     (setter("meshes", 5), ["meshes = 5: expected an array"]),
+    (setter("nodes", 0, "matrix", [float("nan")] * 16), ["nodes[0].matrix[0] = NaN: expected a number"]),
+    (setter("nodes", 0, "scale", [1e400, 1, 1]), ["nodes[0].scale[0] = Infinity: expected a number"]),
     (lambda doc: doc["accessors"][0].pop("componentType"), ["accessors[0].componentType: missing"]),
 ])
 def test_json_values_of_the_wrong_type_are_named_by_their_key(tmp_path, change, parts):
@@ -133,6 +140,8 @@ def test_json_values_of_the_wrong_type_are_named_by_their_key(tmp_path, change, 
     (setter("materials", 0, "pbrMetallicRoughness", 5), ["materials[0].pbrMetallicRoughness = 5: expected an object"]),
     (setter("materials", 0, "pbrMetallicRoughness", "baseColorFactor", [1]),
      ["materials[0].pbrMetallicRoughness.baseColorFactor = [1]: expected an array of 4 numbers"]),
+    (setter("materials", 0, "pbrMetallicRoughness", "baseColorFactor", [float("nan"), 1, 1, 1]),
+     ["materials[0].pbrMetallicRoughness.baseColorFactor[0] = NaN: expected a number"]),
     (setter("textures", 0, "source", 4), ["refers to images[4], which it does not have"]),
     (setter("images", 0, "uri", "data:image/png;base64,iVBORw0KGgo="), ["images[0]", "damaged or truncated PNG"]),
 ])
@@ -141,7 +150,7 @@ def test_material_values_of_the_wrong_type_are_named_by_their_key(tmp_path, chan
     refused(hostile(tmp_path, change, image_uri="albedo.png"), *parts)
 
 
-@pytest.mark.parametrize("name", ["KHR_texture_transform", "EXT_meshopt_compression", "KHR_draco_mesh_compression"])
+@pytest.mark.parametrize("name", ["EXT_meshopt_compression", "KHR_draco_mesh_compression"])
 def test_a_required_extension_we_do_not_implement_is_refused_by_name(tmp_path, name):
     def require(doc):
         doc["extensionsUsed"] = doc["extensionsRequired"] = [name]
@@ -217,3 +226,79 @@ def test_the_strided_reader_checks_its_bounds_itself():
     for offset, count, item, stride in ((-1, 1, 4, 4), (0, 2, 12, 8), (0, 6, 12, 12), (60, 1, 8, 8)):
         with pytest.raises(ValueError, match="bounds not checked"):
             gltf_accessors._rows(raw, offset, count, item, stride)
+
+
+def with_transform(albedo: dict | None, normal: dict | None = None, required: bool = False):
+    """A change giving the quad's material KHR_texture_transforms (None: none) on its albedo and a normal map."""
+    def change(doc):
+        material = doc["materials"][0]
+        if albedo is not None:
+            material["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {"KHR_texture_transform": albedo}
+        material["normalTexture"] = {"index": 0}
+        if normal is not None:
+            material["normalTexture"]["extensions"] = {"KHR_texture_transform": normal}
+        doc["extensionsUsed"] = ["KHR_texture_transform"]
+        if required:
+            doc["extensionsRequired"] = ["KHR_texture_transform"]
+    return change
+
+
+@pytest.mark.parametrize("required", [False, True])
+def test_a_texture_transform_is_applied_to_the_uvs(tmp_path, required):
+    """offset, rotation and scale as the ratified extension defines them: uv' = T R S uv, R = [[c, s], [-s, c]]. Its
+    own example (offset [0, 1], a quarter turn, scale 0.5) maps the uv square onto the image's lower-left quarter."""
+    (tmp_path / "albedo.png").write_bytes(cv2.imencode(".png", RED_BLUE)[1].tobytes())
+    transform = {"offset": [0, 1], "rotation": np.pi / 2, "scale": [0.5, 0.5]}
+    path = hostile(tmp_path, with_transform(transform, transform, required), image_uri="albedo.png")
+    uv = meshes.load_mesh(path).vertices[:, 10:12].astype(np.float64)
+    corners = np.asarray(GOOD["positions"])[np.asarray(GOOD["faces"]).ravel()]
+    original = QUAD_UV[np.asarray(GOOD["faces"]).ravel()]
+    expected = np.stack([0.5 * original[:, 1], 1.0 - 0.5 * original[:, 0]], axis=1)
+    assert np.allclose(meshes.load_mesh(path).vertices[:, :3], corners)
+    assert np.allclose(uv, expected, atol=1e-6), uv
+    assert uv[:, 0].max() <= 0.5 + 1e-6 and uv[:, 1].min() >= 0.5 - 1e-6  # the lower-left quarter
+
+
+def test_textures_with_different_transforms_are_refused_by_name(tmp_path):
+    (tmp_path / "albedo.png").write_bytes(cv2.imencode(".png", RED_BLUE)[1].tobytes())
+    path = hostile(tmp_path, with_transform({"scale": [2, 2]}), image_uri="albedo.png")
+    refused(path, "baseColorTexture and normalTexture have different KHR_texture_transforms")
+
+
+def test_a_material_the_scene_replaces_is_not_read(tmp_path):
+    """A damaged embedded image in the file's material: no error when the scene gives the object its own."""
+    broken = "data:image/png;base64,iVBORw0KGgo="
+    hostile(tmp_path, setter("images", 0, "uri", broken), image_uri="albedo.png")
+    scene = load_scene(mesh_scene(tmp_path, "h.gltf", material="bricks"))
+    assert scene.objects[0].material == "bricks" and scene.objects[0].size == (2.0, 2.0, 0.0)
+    with pytest.raises(UserError, match="damaged or truncated PNG"):
+        load_scene(mesh_scene(tmp_path, "h.gltf"))
+
+
+def test_a_node_of_scale_0_is_left_out_with_a_warning(tmp_path, caplog):
+    path = write_gltf(tmp_path / "two.gltf", **GOOD, nodes=[("shown", (0, 0, 0)), ("hidden", (3, 0, 0))])
+    doc = json.loads(path.read_text())
+    doc["nodes"][1]["scale"] = [0, 1, 1]
+    path.write_text(json.dumps(doc))
+    with caplog.at_level(logging.WARNING, "wgpuviewer.meshes"):
+        mesh = meshes.load_mesh(path)
+    assert len(mesh.vertices) == 6 and np.abs(mesh.vertices[:, 0]).max() == 1.0
+    assert "node 'hidden' mesh 0 primitive 0: its node transform is flat (a scale of 0" in caplog.text
+    doc["nodes"][0]["scale"] = [1, 0, 1]
+    path.write_text(json.dumps(doc))
+    refused(path, "mesh 0 primitive 0: its node transform is flat", "(and 1 more)", "nothing left to show")
+
+
+@pytest.mark.parametrize("translation, parts", [
+    ([1e20, 0, 0], ["places it 1e+20 from the origin, too far for float32"]),
+    ([1e39, 0, 0], ["places it 1e+39 from the origin, beyond float32's range"]),
+])
+def test_triangles_lost_to_float32_name_the_node_transform(tmp_path, translation, parts):
+    message = refused(hostile(tmp_path, setter("nodes", 0, "translation", translation)), "node 'quad'", *parts)
+    assert "zero area" not in message
+
+
+def test_an_image_behind_a_symbolic_link_loop_is_one_line(tmp_path):
+    os.symlink(tmp_path / "b.png", tmp_path / "a.png")
+    os.symlink(tmp_path / "a.png", tmp_path / "b.png")
+    refused(hostile(tmp_path, lambda doc: None, image_uri="a.png"), "images[0]", "symbolic link loop")

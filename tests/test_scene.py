@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from wgpuviewer.core.errors import UserError
+from wgpuviewer.meshes import DEFAULT_SIZES, build
 from wgpuviewer.scene import Scene, default_scene_path, load_scene, parse_scene
 from wgpuviewer.scene.model import DEFAULT_LIGHT
 from wgpuviewer.techniques import TECHNIQUES
@@ -281,7 +282,6 @@ def test_out_of_range(tmp_path, text, parts):
     (scene_text(objects=""), ["objects: missing required key", "at least one [[objects]]"]),
     (scene_text("objects = []", objects=""), ["objects = []: expected at least one [[objects]]"]),
     (scene_text(objects="[[objects]]\nmaterial = 'rock'\nsize = [1, 1]\n"), ["objects[0].type: missing required key"]),
-    (scene_text(objects="[[objects]]\ntype = 'plane'\nmaterial = 'rock'\n"), ["objects[0].size: missing required key"]),
     (scene_text(material="[materials.rock]\nheight = 'builtin:bumps'\n"),
      ["materials.rock.albedo: missing required key"]),
     (scene_text(tail="[[lights]]\ntype = 'directional'\n"), ["lights[0].direction: missing required key"]),
@@ -289,6 +289,15 @@ def test_out_of_range(tmp_path, text, parts):
 ])
 def test_missing_required(tmp_path, text, parts):
     error(tmp_path, text, *parts)
+
+
+def test_builtin_shapes_without_a_size_get_their_default(tmp_path):
+    objects = "".join(f"[[objects]]\ntype = '{kind}'\nmaterial = 'rock'\n" for kind in DEFAULT_SIZES)
+    scene = load_scene(write(tmp_path, scene_text(objects=objects)))
+    assert [o.size for o in scene.objects] == list(DEFAULT_SIZES.values())
+    for obj in scene.objects:  # each default fills a cube of side 1 around the origin
+        reach = np.abs(build(obj.type, obj.size)[:, :3]).max(axis=0)
+        assert np.isclose(reach.max(), 0.5, atol=1e-6), (obj.type, reach)
 
 
 def test_missing_file(tmp_path):

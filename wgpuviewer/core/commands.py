@@ -76,10 +76,10 @@ def _warnings_as_lines(prog: str) -> None:
 
 
 @contextlib.contextmanager
-def terminal_progress(what: str, delay: float = 1.0):
+def terminal_progress(what: str, delay: float = 1.0, unit: str = "map"):
     """Yields ``progress(label, done, total)`` feeding a tqdm bar on stderr: shown once the work has taken
     ``delay`` seconds, only on a terminal, redrawn every half second (its clock runs during one long step, e.g.
-    a 3D distance map), gone when the work ends."""
+    a 3D distance map), gone when the work ends. ``unit`` names what ``done`` counts."""
     from tqdm import tqdm
 
     state: dict = {}
@@ -94,7 +94,7 @@ def terminal_progress(what: str, delay: float = 1.0):
     def progress(label: str, done: int, total: int) -> None:
         if "bar" not in state:
             state["start"] = time.monotonic()
-            state["bar"] = tqdm(total=total, desc=what, unit="map", file=sys.stderr, delay=delay, disable=None,
+            state["bar"] = tqdm(total=total, desc=what, unit=unit, file=sys.stderr, delay=delay, disable=None,
                                 leave=False, dynamic_ncols=True)
             threading.Thread(target=tick, daemon=True).start()
         bar = state["bar"]

@@ -1,7 +1,7 @@
 """Image headers: format, size and channels of an image or ``.npy`` file from its first bytes only, with every limit
 checked there (``read_header``): a file declaring 60000x60000 is refused at once, before any data is read. Empty,
 truncated, missing and directory inputs are refused there too; a broken symbolic link or a link loop is named as
-such (``link_problem``).
+such (``link_problem``), and ``resolve_path`` makes any input path absolute with a link loop one FileError.
 
 A source is a path or an ``ImageBytes`` (an image file's bytes held in memory, such as one a glTF embeds): both are
 read alike, the bytes without a temporary file. Headers: ``.npy`` through numpy's header reader, EXR through the
@@ -207,6 +207,15 @@ def link_problem(path) -> str | None:
         if e.errno == errno.ELOOP:
             return "symbolic link loop (the link leads back to itself); fix or remove the link"
     return None
+
+
+def resolve_path(path) -> Path:
+    """``path`` made absolute with its links followed (``Path.resolve``); a symbolic link loop on the way is a
+    FileError naming it (``resolve`` itself raises RuntimeError or OSError there, which would be an internal error)."""
+    try:
+        return Path(path).resolve()
+    except (RuntimeError, OSError) as e:
+        raise FileError(path, link_problem(path) or f"symbolic link loop on its path ({e}); fix or remove the link") from None
 
 
 def read_header(source) -> Header:

@@ -42,11 +42,12 @@ from .image_headers import (
     link_problem,
     open_source,
     read_header,
+    resolve_path,
 )
 from .native_output import native_stderr, python_stdout
 
 __all__ = ["HEIGHT_CHANNELS", "MAX_CHANNELS", "MAX_SIDE", "NAN_POLICIES", "Header", "ImageBytes", "fill_nonfinite",
-           "link_problem", "read_header", "read_height", "read_image"]
+           "link_problem", "read_header", "read_height", "read_image", "resolve_path"]
 
 HEIGHT_CHANNELS = ("auto", "grey", "r", "g", "b", "a", "luma")
 NAN_POLICIES = ("error", "zero", "nearest")

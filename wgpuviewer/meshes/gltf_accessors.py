@@ -18,6 +18,7 @@ from urllib.parse import unquote
 import numpy as np
 
 from wgpuviewer.core.errors import FileError
+from wgpuviewer.core.images import resolve_path
 
 from . import model
 from .gltf_document import Document
@@ -42,7 +43,10 @@ class Accessors:
 
     def external_file(self, uri: str, what: str) -> Path:
         """The file a (non-data) URI names, next to the glTF file; it must exist."""
-        file = (self.path.parent / unquote(uri)).resolve()
+        try:
+            file = resolve_path(self.path.parent / unquote(uri))
+        except FileError as error:
+            self.fail(f"{what}: file {uri!r}: {error.reason}")
         if not file.is_file():
             self.fail(f"{what}: file {uri!r} not found (looked for {file})")
         return file

@@ -6,8 +6,9 @@ Before: a GLB's framing is checked (magic, version, declared length against the 
 file, the JSON chunk first), and the JSON's values are checked against the types of every key we read (``SCHEMA``):
 pygltflib's decoder coerces what it meets (a ``uri`` of 5 becomes ``"5"``, an ``asset`` of ``"2.0"`` fails deep
 inside it), so a value of the wrong type is named here by its key (``buffers[0].uri = 5: expected a string``).
-After: ``extensionsRequired`` naming an extension we do not implement is refused by name (a texture transform is
-never silently dropped), and the version must be 2.x.
+After: ``extensionsRequired`` naming an extension we do not implement is refused by name (Draco and meshopt: their
+accessors hold no plain data), and the version must be 2.x. KHR_texture_transform is implemented (``gltf`` applies
+it to the uvs), required or not.
 """
 
 from __future__ import annotations
@@ -26,18 +27,17 @@ _GLB_MAGIC = b"glTF"
 _JSON_CHUNK, _BIN_CHUNK = 0x4E4F534A, 0x004E4942
 
 #: Extensions a file may require: KHR_mesh_quantization only widens the component types of attributes, which the
-#: accessor reader takes as they come.
-SUPPORTED_EXTENSIONS = frozenset({"KHR_mesh_quantization"})
+#: accessor reader takes as they come; KHR_texture_transform is applied to the uvs (``gltf``).
+SUPPORTED_EXTENSIONS = frozenset({"KHR_mesh_quantization", "KHR_texture_transform"})
 #: The fix for a required extension we do not implement.
 _EXTENSION_FIXES = {
-    "KHR_texture_transform": "bake the texture transform into the uvs when exporting (or export without it and set "
-                             "the material's uv_scale / uv_offset in the scene)",
     "KHR_draco_mesh_compression": "export without Draco compression",
     "EXT_meshopt_compression": "export without meshopt compression",
 }
 
 INT, NUMBER, STRING, BOOL, OBJECT = "an integer", "a number", "a string", "true or false", "an object"
-_TEXTURE_INFO = {"index!": INT, "texCoord": INT, "extensions": OBJECT}
+_TEXTURE_INFO = {"index!": INT, "texCoord": INT, "extensions": {
+    "KHR_texture_transform": {"offset": [NUMBER, 2], "rotation": NUMBER, "scale": [NUMBER, 2], "texCoord": INT}}}
 #: The types of every key read (``name!``: required). ``{...}``: an object; ``[T]``: an array of T; ``[T, n]``: n
 #: of them; ``{"*": T}``: an object whose every value is a T.
 SCHEMA = {

@@ -1,6 +1,7 @@
 """The builtin shapes, in the vertex layout of ``tangents``: plane, quad and box (flat faces), and the curved
 sphere, cylinder and torus (parametric surfaces with analytic normals and tangents). Every shape is a non-indexed
-triangle list, front faces counter-clockwise seen from outside; ``BUILTIN_SHAPES`` names each one's size keys."""
+triangle list, front faces counter-clockwise seen from outside; ``BUILTIN_SHAPES`` names each one's size keys and
+``DEFAULT_SIZES`` gives the size a scene may leave out."""
 
 from __future__ import annotations
 
@@ -151,6 +152,17 @@ BUILTIN_SHAPES = {
     "sphere": (("radius",), sphere),
     "cylinder": (("radius", "height"), cylinder),
     "torus": (("major radius", "minor radius"), torus),
+}
+
+
+#: Builtin object type -> its size where a scene gives none: each shape filling a cube of side 1 around its origin.
+DEFAULT_SIZES = {
+    "plane": (1.0, 1.0),
+    "quad": (1.0, 1.0),
+    "box": (1.0, 1.0, 1.0),
+    "sphere": (0.5,),
+    "cylinder": (0.5, 1.0),
+    "torus": (0.35, 0.15),
 }
 
 

@@ -34,14 +34,27 @@ def transformed(vertices: np.ndarray, matrix: np.ndarray, offset=(0.0, 0.0, 0.0)
     normal_matrix = np.linalg.inv(m).T
     n, t = v[:, 3:6], v[:, 6:9]
     bitangent = v[:, 9:10] * np.cross(n, t)
-    n2 = _unit(n @ normal_matrix.T)
-    t2 = t @ m.T
+    n2 = _unit(_mapped(n, normal_matrix))
+    t2 = _mapped(t, m)
     t2 = _unit(t2 - n2 * np.einsum("ij,ij->i", t2, n2)[:, None])
-    w = np.where(np.einsum("ij,ij->i", np.cross(n2, t2), bitangent @ m.T) < 0, -1.0, 1.0)
-    out = np.concatenate([v[:, :3] @ m.T + offset, n2, t2, w[:, None], v[:, 10:12]], axis=1)
+    w = np.where(np.einsum("ij,ij->i", np.cross(n2, t2), _mapped(bitangent, m)) < 0, -1.0, 1.0)
+    out = np.concatenate([_mapped(v[:, :3], m) + offset, n2, t2, w[:, None], v[:, 10:12]], axis=1)
     if np.linalg.det(m) < 0:
         out = out.reshape(-1, 3, VERTEX_FLOATS)[:, ::-1].reshape(-1, VERTEX_FLOATS)
     return out
+
+
+def _mapped(vectors: np.ndarray, matrix: np.ndarray) -> np.ndarray:
+    """``vectors @ matrix.T`` for (n, 3) vectors, as three scaled columns: numpy's matmul of a strided (n, 3) by a
+    3x3 takes seconds for millions of vectors (no BLAS path), this some milliseconds."""
+    return vectors[:, 0:1] * matrix[:, 0] + vectors[:, 1:2] * matrix[:, 1] + vectors[:, 2:3] * matrix[:, 2]
+
+
+def triangle_areas(corners: np.ndarray) -> np.ndarray:
+    """Twice the area of each triangle of (3n, >= 3) corners, in float64 from the corners as given (float32 corners:
+    the triangles the GPU draws)."""
+    p = corners[:, :3].astype(np.float64).reshape(-1, 3, 3)
+    return np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -62,6 +75,10 @@ def corner_vertices(path: Path, where: str, positions, uv, faces, normals=None, 
     from ``tangents`` (xyz, w: v-handedness in this module's convention) or generated (``vertex_tangents``).
     ``where`` names the part in messages."""
     positions, uv = np.asarray(positions, np.float64), np.asarray(uv, np.float64)
+    for name, array, width in (("positions", positions, 3), ("uvs", uv, 2)):
+        if array.ndim != 2 or array.shape[1] != width:
+            raise FileError(path, f"{where}: {name} of {array.shape[1:] or 1} components; expected {width} (re-export "
+                                  "the mesh)")
     faces = np.asarray(faces, np.int64).reshape(-1, 3)
     if len(faces) and (faces.min() < 0 or faces.max() >= len(positions)):
         raise FileError(path, f"{where}: triangle indices outside its {len(positions)} vertices; re-export the mesh")

@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from wgpuviewer.core.errors import FileError, InputError, UserError
-from wgpuviewer.core.images import link_problem, read_header
+from wgpuviewer.core.images import link_problem, read_header, resolve_path
 from wgpuviewer.core.sidecar import is_recorded
 from wgpuviewer.textures import TextureRef
 
@@ -211,10 +211,11 @@ def with_folder_material(scene: Scene, folder: Path) -> Scene:
     if plane is None:
         raise UserError(f"{where}: the scene {scene.path or scene.name} has no plane to show the material on; "
                         "use a scene with a [[objects]] type = \"plane\"")
-    if not folder.exists():
-        raise UserError(f"{where}: folder not found (looked for {folder.resolve()})")
     try:
-        refs = folder_refs(folder.resolve(), where)
+        resolved = resolve_path(folder)
+        if not resolved.exists():
+            raise UserError(f"{where}: folder not found (looked for {resolved})")
+        refs = folder_refs(resolved, where)
     except FileError as error:
         raise UserError(f"{where}: {error.reason}") from None
     if refs["albedo"] is None:

@@ -96,8 +96,15 @@ def check_geometry(src: str, camera: Camera, objects: tuple[SceneObject, ...], r
         offset = math.hypot(*obj.position)
         reach = offset + math.hypot(*_HALF_EXTENTS[obj.type](obj.size))
         if reach > ratio * d:
-            key = "position" if offset > ratio * d else "size"
-            raise UserError(f"{src}: objects[{i}].{key} = {show_value(raw.get(key, [0, 0, 0]))}: out of range, expected "
+            key = "position" if offset > ratio * d else "scale" if obj.type == "mesh" else "size"
+            given = raw.get(key, {"position": [0, 0, 0], "scale": 1, "size": list(obj.size)}[key])
+            raise UserError(f"{src}: objects[{i}].{key} = {show_value(given)}: out of range, expected "
                             f"|position| + |size| / 2 <= {ratio * d:.4g} (float32 places vertices within 1/4 degree "
                             f"up to {ratio:.0f} x the camera's distance to the object, here {d:.4g}; it reaches "
-                            f"{reach:.4g})")
+                            f"{reach:.4g}){_mesh_size(obj) if key == 'scale' else ''}")
+
+
+def _mesh_size(obj: SceneObject) -> str:
+    """What a mesh object's size is made of, for a message blaming its ``scale``."""
+    size = ", ".join(f"{x:.4g}" for x in obj.size)
+    return f"; the file's mesh at this scale measures [{size}]: give a smaller scale or re-export it in other units"

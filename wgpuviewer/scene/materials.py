@@ -44,7 +44,7 @@ def _texture(t: Table, name: str, base: Path, color_ok: bool = False, required: 
         raise t.error(name, value, f"expected a texture: {expected}")
     if value.startswith("builtin:"):
         return _builtin_ref(t, name, value, (256, 256), origin)
-    return _file_ref(t, name, value, (base / Path(value).expanduser()).resolve())  # base is ignored for absolute
+    return _file_ref(t, name, value, t.file_path(name, value, base))
 
 
 def _file_ref(t: Table, name: str, value, path: Path) -> TextureRef:
@@ -141,7 +141,7 @@ def _named_maps(t: Table, base: Path, height: TextureRef | None, is_depth: bool)
         if is_depth:
             raise maps.error(slot, value, "maptools batch builds maps from height files (1 = top), and this material "
                                           "reads its file as depth; give the height file as height = \"...\"")
-        path = (base / Path(value).expanduser()).resolve()
+        path = maps.file_path(slot, value, base)
         if not path.is_file():
             raise maps.error(slot, value, f"file not found (looked for {path})")
         try:
@@ -169,7 +169,7 @@ def _folder(t: Table, base: Path) -> dict | None:
         return None
     if not isinstance(value, str):
         raise t.error("folder", value, "expected a folder path (a string)")
-    path = (base / Path(value).expanduser()).resolve()
+    path = t.file_path("folder", value, base)
     if not path.exists():
         raise t.error("folder", value, f"folder not found (looked for {path})")
     # keys given next to the folder win: the folder is not searched for their slots (depth fills the height's)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from wgpuviewer.core.errors import FileError, UserError
 from wgpuviewer.core.params import resolve_params
-from wgpuviewer.meshes import MESH_SUFFIXES, NodeNotFound, load_mesh
+from wgpuviewer.meshes import DEFAULT_SIZES, MESH_SUFFIXES, NodeNotFound, load_mesh
 from wgpuviewer.techniques import TECHNIQUES, get_technique
 from wgpuviewer.textures import TextureRef
 
@@ -77,10 +77,10 @@ def _object(src: str, key: str, data, materials: dict[str, Material], base: Path
     position = t.vector("position", 3, [0.0, 0.0, 0.0])
     rotation = t.vector("rotation", 3, [0.0, 0.0, 0.0])
     if object_type != "mesh":
-        size = t.vector("size", OBJECT_SIZES[object_type], lo=0, exclusive=True)
+        size = t.vector("size", OBJECT_SIZES[object_type], list(DEFAULT_SIZES[object_type]), lo=0, exclusive=True)
         return SceneObject(type=object_type, material=material, size=size, position=position, rotation=rotation)
     value = t.string("file")
-    path = (base / Path(value).expanduser()).resolve()
+    path = t.file_path("file", value, base)
     if path.suffix.lower() not in MESH_SUFFIXES:
         raise t.error("file", value, f"unsupported mesh file type; expected {', '.join(MESH_SUFFIXES)}")
     if not path.is_file():
@@ -89,7 +89,7 @@ def _object(src: str, key: str, data, materials: dict[str, Material], base: Path
     scale = ((t.number("scale", 1.0, lo=0, exclusive=True),) * 3 if is_number(t.get("scale", 1.0, ""))
              else t.vector("scale", 3, [1.0, 1.0, 1.0], lo=0, exclusive=True))
     try:
-        mesh = load_mesh(path, node)
+        mesh = load_mesh(path, node, material=material is None)  # a scene material: the file's is not read
     except NodeNotFound as error:
         raise t.error("node", node, error.reason) from None
     except FileError as error:

@@ -1,14 +1,16 @@
 """Reading a scene's TOML: ``Table``, one table being read, with typed getters (number, vector, direction,
-string, boolean, nested tables) whose errors are one line naming the file, the key path, the value and what is
-expected; ``show_value``, a value as messages show it; ``reject_non_finite`` (TOML allows nan and inf, scenes
-do not).
+string, boolean, nested tables, a path relative to the scene) whose errors are one line naming the file, the key
+path, the value and what is expected; ``show_value``, a value as messages show it; ``reject_non_finite`` (TOML
+allows nan and inf, scenes do not).
 """
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
-from wgpuviewer.core.errors import UserError
+from wgpuviewer.core.errors import FileError, UserError
+from wgpuviewer.core.images import resolve_path
 
 from .model import Vec3, normalise
 
@@ -100,6 +102,14 @@ class Table:
         if not isinstance(value, bool):
             raise self.error(name, value, "expected true or false")
         return value
+
+    def file_path(self, name: str, value: str, base: Path) -> Path:
+        """The absolute path of the file or folder ``value`` of key ``name`` (relative to ``base``, the scene's
+        folder; ``~`` expanded); a symbolic link loop on the way is an error naming the key."""
+        try:
+            return resolve_path(base / Path(value).expanduser())  # base is ignored for an absolute value
+        except FileError as error:
+            raise self.error(name, value, error.reason) from None
 
     def array_of_tables(self, name: str) -> list:
         """``[[name]]`` entries; [] when absent."""

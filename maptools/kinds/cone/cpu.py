@@ -23,16 +23,19 @@ positive forward directional derivative. The computation visits bilinear cells C
 c(q) = min(max_ratio, bounds) * (1 - STORE_MARGIN). filter="bilinear" then takes the min over the 3x3 texels
 around each texel, which keeps a bilinear lookup of the map (a mix of the 4 texels around p, all neighbours of
 p's own texel) below the nearest-lookup value. Each texel's ring walk stops once no further ring can lower its
-value, as on the GPU.
+value, as on the GPU. ``cone`` shows a progress bar on a terminal once it has taken a second (texels settled: the
+ring walk of a 2048x2048 map takes tens of seconds).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
 from maptools.volume.cpu import index_arrays
+from wgpuviewer.core.commands import terminal_progress
 from wgpuviewer.core.errors import UserError
 
 #: Relative margin every stored ratio loses (covers float32 arithmetic on the GPU and the float32 store).
@@ -100,11 +103,12 @@ def _n3x3(a: np.ndarray, op) -> np.ndarray:
     return _neigh(a, op, [(dy, dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1) if dy or dx])
 
 
-def raw_ratio(depth: np.ndarray, max_ratio: float, rows=None, cols=None) -> np.ndarray:
+def raw_ratio(depth: np.ndarray, max_ratio: float, rows=None, cols=None,
+              progress: Callable[[int, int], None] = lambda done, total: None) -> np.ndarray:
     """Nearest-lookup cone ratio (float64, before the store margin) for depth (H, W) float64: (H, W), or only at the
     texels (rows, cols) when given (index arrays; shaped like rows, each value exactly the whole map's). Each texel
     walks the rings until (a - 0.5) min(1, sy) >= c (M_q - global min depth): no farther cell can lower its ratio
-    (the GPU's rule)."""
+    (the GPU's rule). ``progress(settled, texels)`` hears before each ring how many texels have stopped walking."""
     h, w = depth.shape
     sy = w / h
     shape = (h, w) if rows is None else np.shape(rows)
@@ -122,6 +126,7 @@ def raw_ratio(depth: np.ndarray, max_ratio: float, rows=None, cols=None) -> np.n
             live = live[(a - 0.5) * min(1.0, sy) < c[live] * reach[live]]
             if not live.size:
                 break
+        progress(rows.size - live.size, rows.size)
         r, q, m_live = rows[live], cols[live], m[live]
         for di, dj in ring_offsets(a):
             cell = ((r + dj) % h) * w + (q + di) % w
@@ -163,7 +168,9 @@ def finish(raw: np.ndarray, filter: str) -> np.ndarray:
 def cone(height: np.ndarray, *, max_ratio: float = 16.0, filter: str = "bilinear") -> np.ndarray:
     """Relaxed cone ratios, float32 (H, W), texels of u per unit of layer depth t (docs/maps.md)."""
     _check_options(height, max_ratio, filter)
-    return finish(raw_ratio(depth_of(height), max_ratio), filter)
+    with terminal_progress("cone (CPU)", unit="texel") as progress:
+        raw = raw_ratio(depth_of(height), max_ratio, progress=lambda done, total: progress("", done, total))
+    return finish(raw, filter)
 
 
 def _check_options(height: np.ndarray, max_ratio: float, filter: str) -> None:
