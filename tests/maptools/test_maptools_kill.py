@@ -24,11 +24,11 @@ def test_sigkill_mid_batch_leaves_only_complete_outputs(tmp_path, capsys):
     src.mkdir()
     maps = {}
     for n in range(40):
-        maps[f"h{n:02d}"] = rng.random((128, 128)).astype(np.float32)
+        maps[f"h{n:02d}"] = rng.random((64, 64)).astype(np.float32)
         np.save(src / f"h{n:02d}.npy", maps[f"h{n:02d}"])
     out = tmp_path / "out"
     argv = [sys.executable, "-c", "import sys; from maptools.cli import main; sys.exit(main())", "batch", str(src),
-            "-o", str(out), "--kinds", KINDS, "--backend", "cpu", "--set", "distance.slices=24"]
+            "-o", str(out), "--kinds", KINDS, "--backend", "cpu", "--set", "distance.slices=16"]
     proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 60
@@ -60,20 +60,20 @@ def test_sigkill_mid_batch_leaves_only_complete_outputs(tmp_path, capsys):
             import cv2
 
             img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
-            assert img is not None and img.shape == (128, 128, 3)
+            assert img is not None and img.shape == (64, 64, 3)
         else:
-            want = maptools.generate(kind, maps[stem], backend="cpu", slices=24)
+            want = maptools.generate(kind, maps[stem], backend="cpu", slices=16)
             assert np.array_equal(np.load(p), want)
     done = {n[: -len(".json")] for n in names if n.endswith(".json")}
     assert done <= set(names)  # a sidecar only ever follows its complete output
     # the re-run completes the rest and skips what was finished
     capsys.readouterr()
     code = cli.main(["batch", str(src), "-o", str(out), "--kinds", KINDS, "--backend", "cpu",
-                     "--set", "distance.slices=24", "--jobs", "2"])
+                     "--set", "distance.slices=16", "--jobs", "2"])
     assert code == 0
     assert f"{120 - len(done)} generated, {len(done)} up to date, 0 failed" in capsys.readouterr().out
     assert len(list(out.glob("*.json"))) == 40 * 3
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
     assert cli.main(["batch", str(src), "-o", str(out), "--kinds", KINDS, "--backend", "cpu",
-                     "--set", "distance.slices=24"]) == 0
+                     "--set", "distance.slices=16"]) == 0
     assert "0 generated, 120 up to date" in capsys.readouterr().out
