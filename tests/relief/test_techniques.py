@@ -282,7 +282,8 @@ def _cost_scale_by_parameter_names(params: dict) -> float:
     if "max_layers" in params:
         return float(params["max_layers"] + 1)
     if "linear_steps" in params:
-        return float(params["linear_steps"] + 1 + params.get("binary_steps", 0))
+        # contact's second search: its sub-step at the bracket's solid end is the march's own sample
+        return float(params["linear_steps"] + 1 + params.get("binary_steps", 0) + params.get("refine_steps", 1) - 1)
     return COMMON_COST_SCALE
 
 
@@ -428,7 +429,7 @@ def test_markdown_table_has_a_row_per_technique():
 # --- the registry: one folder per technique, found without a list ------------------------------------------
 
 #: The registry's order (the viewer's keys, the README table, the benchmark's rows).
-ORDER = ("basic", "normal", "parallax", "steep", "pom", "pom_adaptive", "relief", "maxmip", "distance",
+ORDER = ("basic", "normal", "parallax", "steep", "pom", "pom_adaptive", "relief", "contact", "maxmip", "distance",
          "distance_refined", "quadmax", "quadmax_pom", "auto", "cone")
 
 

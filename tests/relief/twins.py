@@ -87,3 +87,46 @@ def relief_from(height, uv0, view, height_scale, linear_steps, binary_steps, dep
     else:
         raise ValueError(f"finish = {finish!r}: expected one of {RELIEF_FINISHES}")
     return np.where(bracketed, t_hit, lo), fetches
+
+
+def contact_from(height, uv0, view, height_scale, linear_steps, refine_steps, depth_range):
+    """float64 contact-refinement search (techniques/contact/contact.wgsl): ``linear_steps`` equal layers of the
+    depth range (lo, hi), then sub-steps 1 .. refine_steps - 1 of the bracket [last layer above, first layer on or
+    below] up to the first one on or below the surface, then relief's secant through the final sub-bracket. Returns
+    the layer depth t of the result and the fetches per ray."""
+    span = view[:, :2] / view[:, 2:3] * height_scale
+    depth = 1.0 - height
+    lo, hi = depth_range
+    step = (hi - lo) / linear_steps
+
+    def depth_at(t):
+        return bilinear(depth, uv0 - span * t[:, None])
+
+    n = len(uv0)
+    t_solid, d_solid = np.full(n, lo), depth_at(np.full(n, lo))
+    t_free, d_free = t_solid.copy(), d_solid.copy()
+    fetches = np.ones(n, np.int64)
+    searching = t_solid < d_solid
+    bracketed = searching.copy()  # else the entry point is on or below the surface: the result is lo
+    for i in range(1, linear_steps + 1):
+        t = np.full(n, lo + i * step)
+        d = np.where(searching, depth_at(t), d_solid)
+        t_free, d_free = np.where(searching, t_solid, t_free), np.where(searching, d_solid, d_free)
+        t_solid, d_solid = np.where(searching, t, t_solid), np.where(searching, d, d_solid)
+        fetches += searching
+        searching &= t < d
+    base, sub = t_free.copy(), (t_solid - t_free) / refine_steps
+    refining = bracketed.copy()
+    for k in range(1, refine_steps):
+        t = base + k * sub
+        d = np.where(refining, depth_at(t), 0.0)
+        fetches += refining
+        solid = refining & (t >= d)
+        t_solid, d_solid = np.where(solid, t, t_solid), np.where(solid, d, d_solid)
+        free = refining & ~solid
+        t_free, d_free = np.where(free, t, t_free), np.where(free, d, d_free)
+        refining = free
+    above, below = d_free - t_free, d_solid - t_solid
+    w = np.clip(above / np.where(bracketed & (above - below > 0), above - below, 1.0), 0.0, 1.0)
+    w = np.where(above - below > 0, w, 0.0)
+    return np.where(bracketed, t_free + w * (t_solid - t_free), lo), fetches

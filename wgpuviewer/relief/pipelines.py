@@ -1,7 +1,8 @@
 """The render pipelines and what they are laid out with: the bind-group layouts (group 0 the Frame, 1 a material's
 trace parameters, sampler and textures, 2 the Object, ``FILTER_GROUP`` the filter's uniform and sampler), the
 samplers, and the pipelines themselves, compiled on first use and cached per technique x filter x derivative
-source x target formats x fragment entry x material variant (``shaders.MaterialVariant``). One ``Pipelines`` is
+source x target formats x fragment entry x material variant (``shaders.MaterialVariant``: shadows, depth offset,
+addressing and the technique's code paths the material runs, e.g. auto's methods). One ``Pipelines`` is
 shared by renderers of scenes with the same materials (``Renderer(..., like=...)``)."""
 
 from __future__ import annotations

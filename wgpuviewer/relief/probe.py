@@ -34,7 +34,8 @@ from .reference import real_array, real_number
 from .shaders import compose_technique, pack_trace_params
 
 #: The probe's records (entry/probe.wgsl binds an array of each and declares neither): a ray in, its hit out.
-PROBE_RAY = Struct("ProbeRay", [("uv", "vec2f"), ("view", "vec3f")], "storage")  # view: V in tangent space
+#: view: V in tangent space; dx, dy: the ray's pixel footprint, uv per pixel along screen x and y (zero: none).
+PROBE_RAY = Struct("ProbeRay", [("uv", "vec2f"), ("view", "vec3f"), ("dx", "vec2f"), ("dy", "vec2f")], "storage")
 PROBE_HIT = Struct("ProbeHit", [("uv", "vec2f"), ("depth", "f32"), ("fetches", "u32"), ("capped", "u32"),
                                 ("layers", "u32")], "storage")
 #: The shadow probe's records (entry/shadow_probe.wgsl): a point in the relief and a light in, its shadows out.
@@ -157,6 +158,7 @@ def probe(
     *,
     address: str = "repeat",
     backend: str | None = None,
+    footprint=None,
     **params,
 ) -> ProbeResult:
     """Trace rays with ``technique`` on the GPU.
@@ -165,6 +167,8 @@ def probe(
     technique needs are built from it (cached by maptools), exactly as the renderer builds them.
     uv: (N, 2) or (2,) entry points; view_dir: (N, 3) or (3,) tangent-space V (towards the eye); one of them
     broadcasts against the other, and N = 0 gives an empty result. height_scale: relief depth in UV units.
+    footprint: (N, 4) or (4,) each ray's pixel on screen, uv per pixel (du/dx, dv/dx, du/dy, dv/dy), as the renderer
+    passes a fragment's derivatives (auto's ``max_error_px`` reads it); None: no footprint (zero).
     params: technique parameters (e.g. ``layers=64``), validated against the registry.
     """
     tech = get_technique(technique)
@@ -182,6 +186,9 @@ def probe(
         raise InputError(f"probe: uv has {len(uv)} rows but view_dir has {len(view)}; expected equal counts, or "
                          "one row for all")
     n = max(len(uv), len(view)) if len(uv) and len(view) else 0
+    pixel = np.zeros((1, 4)) if footprint is None else _rows(footprint, 4, "footprint")
+    if len(pixel) not in (1, n):
+        raise InputError(f"probe: footprint has {len(pixel)} rows for {n} rays; expected one per ray, or one row for all")
     uv = np.broadcast_to(uv, (n, 2))
     view = np.broadcast_to(view, (n, 3))
     if n == 0:
@@ -193,7 +200,7 @@ def probe(
     else:
         offset = np.zeros_like(uv)
         far = (np.abs(uv) > _CLAMP_RESOLVED / max(height.shape)).any(axis=1)
-    hits = _trace(tech, values, height, uv - offset, view, scale, address, backend)
+    hits = _trace(tech, values, height, uv - offset, view, np.broadcast_to(pixel, (n, 4)), scale, address, backend)
     hits.uv = hits.uv + offset
     hits.capped |= far | ~np.isfinite(hits.uv).all(axis=1) | ~np.isfinite(hits.depth)
     return hits
@@ -219,15 +226,15 @@ def _rows(a, width: int, name: str) -> np.ndarray:
     return arr
 
 
-def _trace(tech, values: dict, height: np.ndarray, uv: np.ndarray, view: np.ndarray, height_scale: float,
-           address: str, backend) -> ProbeResult:
-    """Run the technique's probe kernel on the rays (uv, view: float64 (n, 2), (n, 3), n >= 1)."""
+def _trace(tech, values: dict, height: np.ndarray, uv: np.ndarray, view: np.ndarray, pixel: np.ndarray,
+           height_scale: float, address: str, backend) -> ProbeResult:
+    """Run the technique's probe kernel on the rays (uv, view, pixel: float64 (n, 2), (n, 3), (n, 4), n >= 1)."""
     n = len(uv)
     gpu = get_gpu(backend, quiet=True)
     compute = compute_for(gpu)
     kernel = _kernel(gpu, tech.name)
     rays = np.zeros(n, PROBE_RAY.dtype)
-    rays["uv"], rays["view"] = uv, view
+    rays["uv"], rays["view"], rays["dx"], rays["dy"] = uv, view, pixel[:, :2], pixel[:, 2:]
     ray_buf = compute.storage(PROBE_RAY.pack_many(rays), f"probe:{n} rays", FEWER)
     hit_buf = compute.storage(n * PROBE_HIT.size, f"probe:hits of {n} rays", FEWER)
     layout = kernel.pipeline(ENTRY).get_bind_group_layout(1)

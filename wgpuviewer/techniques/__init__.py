@@ -88,6 +88,13 @@ class Technique(Parametrized):
     #: Lines the viewer's info panel shows under the technique, given the scene's materials (name -> material) and
     #: the parameters (auto: what it chooses per view-angle range on each material); None: none.
     panel_lines: Callable[[dict, dict], list[str]] | None = None
+    #: Code paths of its WGSL a material's draw may leave out (auto: its candidates' methods): each NAME gets a
+    #: generated ``const USES_NAME: bool`` (``relief.shaders``), true unless the draw's material variant leaves it out,
+    #: and its WGSL runs the path only under it, so the compiler drops the paths a material does not take.
+    code_paths: tuple[str, ...] = ()
+    #: Which ``code_paths`` drawing a material (a scene material) with parameters ``params`` runs; the renderer
+    #: compiles a module per distinct answer (``MaterialVariant.paths``). None: every path, always.
+    paths_used: Callable[[object, dict], tuple[str, ...]] | None = None
 
     @property
     def wgsl_file(self) -> str:

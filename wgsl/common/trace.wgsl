@@ -19,6 +19,11 @@ struct TraceResult {
 // Counted so every technique reports its cost the same way.
 var<private> fetch_count: u32;
 
+// The ray's pixel on screen: uv per pixel along screen x (column 0) and y (column 1), set by the entry point before
+// `trace` (render: the unperturbed uv's derivatives; probe: the ray's own, or none); zero where there is none. A
+// screen-space error budget reads it (auto's max_error_px: zero falls back to the texel budget).
+var<private> pixel_footprint: mat2x2f;
+
 fn is_grazing(v: vec3f) -> bool {
     return v.z < MIN_VIEW_Z;
 }

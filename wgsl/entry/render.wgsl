@@ -95,6 +95,7 @@ fn shade(in: VertexOut) -> Shaded {
     let texels = vec2f(f32(trace_params.depth_width), f32(trace_params.depth_height));
     let footprint = max(dot(duv_dx * texels, duv_dx * texels), dot(duv_dy * texels, duv_dy * texels));
     let lod = max(0.5 * log2(max(footprint, 1e-12)), 0.0);
+    pixel_footprint = mat2x2f(duv_dx, duv_dy);
 
     let n_geo = normalize(in.normal);
     let t_geo = normalize(in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz));

@@ -15,8 +15,11 @@ from .autotable import (
     AUTO_BUDGET_LEVELS,
     AUTO_BUDGET_LOG2_MIN,
     AUTO_CANDIDATES,
+    AUTO_METHODS,
     AUTO_TAN0,
+    MAX_ERROR_PX,
     panel_lines,
+    paths_used,
 )
 from .slot import AUTO_TABLE_SLOT
 
@@ -32,13 +35,18 @@ TECHNIQUE = Technique(
     "The error budget as a technique: per pixel, the view angle picks the cheapest candidate (basic, "
     "parallax, POM 4-64 layers, relief 4-32 linear steps with 1 or 2 binary steps, quadmax) whose p97.5 UV "
     "error the probe measured within max_error on this material's own height map, at both ends of the "
-    "angle bin (techniques/auto/autotable.py; cached with the maps).",
+    "angle bin (techniques/auto/autotable.py; cached with the maps). With max_error_px > 0 the budget grows "
+    "with the texels a pixel spans along the ray.",
     "the chosen candidate's fetches (one table texel, not counted)",
     ("albedo", "normal", "depth", "quadmax", "auto_table"),
     (Param("max_error", 0.5, 2.0 ** AUTO_BUDGET_LOG2_MIN, 2.0 ** (AUTO_BUDGET_LOG2_MIN + AUTO_BUDGET_LEVELS - 1),
            float, "UV error budget in texels (the table's budgets are powers of 2: the largest one not "
-           "above this is used)"),),
+           "above this is used)"),
+     Param("max_error_px", 0.0, 0.0, MAX_ERROR_PX, float, "screen-space budget in pixels (0: off): where a "
+           "pixel spans more than max_error / max_error_px texels along the ray, the texels it spans set the budget "
+           "(auto.wgsl auto_budget), so distant and minified surfaces run cheaper; magnified ones keep max_error")),
     ray_search=True, order=130, slots=(AUTO_TABLE_SLOT,), panel_lines=panel_lines,
+    code_paths=tuple(AUTO_METHODS), paths_used=paths_used,
     fixed=(Fixed("bin_tan0", AUTO_TAN0, "f32"), Fixed("bins_per_octave", AUTO_BINS_PER_OCTAVE, "u32"),
            Fixed("budget_log2_min", AUTO_BUDGET_LOG2_MIN, "i32"), Fixed("quadmax_steps", QUADMAX_STEPS, "u32"),
            Fixed("binary_steps_max", RELIEF_BINARY_STEPS_MAX, "u32")),
@@ -47,6 +55,6 @@ TECHNIQUE = Technique(
     # the layers view shows the chosen candidate (1-based, cheapest first) instead of a layer count
     layers_view_range=lambda p: (1.0, float(len(AUTO_CANDIDATES))),
     contract_params=({"max_error": 2.0 ** AUTO_BUDGET_LOG2_MIN},
-                     {"max_error": 2.0 ** (AUTO_BUDGET_LOG2_MIN + AUTO_BUDGET_LEVELS - 1)}),
+                     {"max_error": 2.0 ** (AUTO_BUDGET_LOG2_MIN + AUTO_BUDGET_LEVELS - 1)}, {"max_error_px": 0.5}),
     accuracy_settings=({"max_error": 0.25}, {"max_error": 0.5}, {"max_error": 1.0}),
 )

@@ -26,6 +26,7 @@ candidates, their WGSL code, the rays; ``maptools.cache``'s key and folder, kind
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 
@@ -63,6 +64,8 @@ AUTO_BINS = 29
 #: one not above it.
 AUTO_BUDGET_LOG2_MIN = -4
 AUTO_BUDGET_LEVELS = 8
+#: max_error_px's upper end (screen pixels; 0 turns the screen-space budget off).
+MAX_ERROR_PX = 16.0
 
 #: Bump when what ``measure`` computes changes (cached tables are then measured again).
 VERSION = 5
@@ -252,8 +255,23 @@ def table_texture(gpu: Gpu, table: np.ndarray, label: str):
     return create_texture(gpu, [texels(table)], "rgba32float", label)
 
 
+def fragment_budget(max_error: float, max_error_px: float, footprint, view) -> np.ndarray:
+    """auto.wgsl's auto_budget in float64: per ray the error budget in texels, max(max_error, max_error_px |det J| /
+    |adj(J) d|) where max_error_px > 0 and det J > 0 (else max_error). ``footprint``: (N, 4) the pixel in texels
+    (J's columns: texels per pixel along screen x, then y); ``view``: (N, 3) tangent-space V, whose xy (in texels)
+    gives d, the direction every hit of the ray lies along."""
+    j = np.asarray(footprint, np.float64).reshape(-1, 4)
+    along = np.asarray(view, np.float64)[:, :2] * np.ones((len(j), 1))
+    norm = np.linalg.norm(along, axis=1, keepdims=True)
+    d = np.where(norm > 1e-15, along / np.where(norm > 0, norm, 1.0), [1.0, 0.0])
+    det = np.abs(j[:, 0] * j[:, 3] - j[:, 1] * j[:, 2])
+    adj = np.stack([j[:, 3] * d[:, 0] - j[:, 2] * d[:, 1], j[:, 0] * d[:, 1] - j[:, 1] * d[:, 0]], -1)
+    screen = max_error_px * det / np.maximum(np.linalg.norm(adj, axis=1), 1e-300)
+    return np.maximum(max_error, np.where((max_error_px > 0) & (det > 0), screen, 0.0))
+
+
 def budget_level(max_error: float) -> int:
-    """auto.wgsl's budget level for max_error: the largest budget 2^(min + j) not above it."""
+    """auto.wgsl's budget level for a budget (texels): the largest budget 2^(min + j) not above it."""
     return int(np.clip(math.floor(math.log2(max_error)) - AUTO_BUDGET_LOG2_MIN, 0, AUTO_BUDGET_LEVELS - 1))
 
 
@@ -286,6 +304,33 @@ def describe(table: np.ndarray, max_error: float) -> list[str]:
                      f"cost <= {float(choice[b:end + 1, 2].max()):.3g}{met}")
         b = end + 1
     return lines
+
+
+def methods_picked(table: np.ndarray, max_error: float, max_error_px: float) -> tuple[str, ...]:
+    """The methods (AUTO_METHODS names, in their order) the shader can run with ``table``: its choices at
+    ``max_error``'s budget level in every bin, and with a screen-space budget (``max_error_px`` > 0: a fragment's
+    budget is max_error or more, ``fragment_budget``) at every level above it too."""
+    level = budget_level(max_error)
+    levels = range(level, AUTO_BUDGET_LEVELS) if max_error_px > 0 else (level,)
+    chosen = {int(c) for c in choose(table)[list(levels), :, 0].ravel()}
+    names = {AUTO_CANDIDATES[c][0] for c in chosen}
+    return tuple(name for name in AUTO_METHODS if name in names)
+
+
+def paths_used(material, params: dict) -> tuple[str, ...]:
+    """auto's ``Technique.paths_used``: the methods its table for ``material`` (a scene material: its depth map at its
+    own height scale, as its ``auto_table`` slot is built) picks at ``params``; its module compiles only those."""
+    return _paths(material, budget_level(params["max_error"]), params["max_error_px"] > 0)
+
+
+@functools.lru_cache(maxsize=256)
+def _paths(material, level: int, screen: bool) -> tuple[str, ...]:
+    """``paths_used`` by what decides it, remembered: the renderer asks on every draw, and reading the table hashes
+    the depth map (tens of ms for 512²)."""
+    from wgpuviewer.relief.material_textures import depth_data
+
+    table = measure(depth_data(material), material.height_scale)
+    return methods_picked(table, float(budgets()[level]), 1.0 if screen else 0.0)
 
 
 def panel_lines(materials: dict, params: dict) -> list[str]:
