@@ -7,6 +7,7 @@ import math
 import os
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,7 @@ import pytest
 import wgpuviewer
 from tests.relief.scenes import material_scene
 from wgpuviewer import api, cli
-from wgpuviewer.core.errors import InputError, UserError
+from wgpuviewer.core.errors import UserError
 from wgpuviewer.scene import default_scene_path, load_scene, parse_scene
 
 SIZE = (32, 24)
@@ -99,18 +100,56 @@ def test_repeated_renders_reuse_the_scene_renderer(small_scene, adapter):
     ({"uv_scale": 0}, ["uv_scale = 0", "above 0"]),
     ({"uv_scale": 1e9}, ["uv_scale = 1000000000.0", "float32 addresses every texel"]),
     ({"filter": "nope"}, ["filter = 'nope'", "unknown filter"]),
+    ({"material": 5}, ["material = 5", "a material folder's path"]),
+    ({"backend": "nope"}, ["backend = 'nope'", "expected one of auto, vulkan"]),
+    ({"shadows": "dark"}, ["shadows = 'dark'", "off, hard, soft"]),
 ])
 def test_bad_arguments_are_one_line_errors_before_the_gpu_starts(monkeypatch, kwargs, fragments):
     def no_gpu(*args, **kw):
         raise AssertionError("the GPU started before the arguments were checked")
 
     monkeypatch.setattr("wgpuviewer.core.gpu.get_gpu", no_gpu)
-    with pytest.raises((InputError, UserError)) as error:
-        wgpuviewer.render(**{"size": SIZE, **kwargs})
-    message = str(error.value)
-    assert "\n" not in message
-    for fragment in fragments:
-        assert fragment in message, message
+    calls = (wgpuviewer.render,) if "mode" in kwargs else (wgpuviewer.render, wgpuviewer.view)
+    for call in calls:  # view checks its arguments as render does
+        with pytest.raises(ValueError) as error:
+            call(**{"size": SIZE, **kwargs})
+        message = str(error.value)
+        assert "\n" not in message and "--" not in message  # the API's names, not the CLI's options
+        for fragment in fragments:
+            assert fragment in message, message
+
+
+def test_file_problems_are_value_errors_naming_the_file(tmp_path):
+    """A scene file or material folder the API cannot use: an ApiError (a ValueError, still a UserError for the
+    CLI), the file named, no CLI option."""
+    broken = tmp_path / "broken.toml"
+    broken.write_text("[camera\n")
+    for kwargs, fragment in (({"scene": broken}, "broken.toml"), ({"scene": tmp_path}, "is a directory"),
+                             ({"material": tmp_path / "none"}, "material = ")):
+        with pytest.raises(ValueError) as error:
+            wgpuviewer.render(**{"size": SIZE, **kwargs})
+        assert isinstance(error.value, UserError | api.ArgumentError) and fragment in str(error.value)
+        assert "--" not in str(error.value)
+
+
+def test_renders_from_threads_match_the_single_threaded_ones(small_scene, adapter):
+    """Four threads rendering one kept renderer at different cameras at once get each its own camera's image."""
+    angles = (20, 45, 70)
+    expected = {a: wgpuviewer.render(small_scene, "pom", SIZE, {"view_angle": a}) for a in angles}
+    results = []
+
+    def work(k):
+        for i in range(3):
+            angle = angles[(i + k) % len(angles)]
+            results.append((angle, wgpuviewer.render(small_scene, "pom", SIZE, {"view_angle": angle})))
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert len(results) == 12
+    assert all(np.array_equal(image, expected[angle]) for angle, image in results)
 
 
 def test_a_missing_scene_file_names_it():

@@ -3,10 +3,17 @@ Jupyter widget), and ``prepare`` (everything ``render`` does before it draws), t
 draws too: one path for a render. The camera a render uses comes from ``camera_for`` (a ``CameraSpec``), a
 material's relief settings from ``with_relief``.
 
-Arguments are checked before the GPU starts; a bad one is an ``InputError`` (a ValueError) of one line naming it,
-most an ``ArgumentError`` that keeps the argument, the value and the reason apart so the CLI words it with its
-options (a bad scene file: a ``UserError`` naming the file and key, as in the CLI). The first GPU use is as quiet as the
-CLI's: no driver line about ``XDG_RUNTIME_DIR`` (``core.gpu``); a software adapter is named once on stderr.
+Arguments are checked before the GPU starts (``view`` checks them as ``render`` does); every error the API raises
+for its input is a ValueError of one line: an ``ArgumentError`` naming the argument (``backend = 'metal': ...``), which
+keeps the argument, the value and the reason apart so the CLI words it with its options, or an ``ApiError`` for a
+problem found in a file (a scene file, a texture: the file and key named, as in the CLI; ``_user_errors``). The
+first GPU use is as quiet as the CLI's: no driver line about ``XDG_RUNTIME_DIR`` (``core.gpu``); a software adapter
+is named once on stderr.
+
+Threads: ``render``, ``prepare`` and ``Prepared.image`` may be called from several threads at once. The kept
+renderers and devices are shared under one lock; a renderer's maps are built once (``Renderer.prepare``) and each
+frame is drawn and read back under its device's lock (``Renderer.render``, ``Gpu.lock``): frames on one device
+are drawn one at a time, each with its own camera and settings.
 
 The subject of a scene: its first plane (where ``--material`` shows a folder), or its first object when it has
 no plane. ``view_angle``, ``height_scale`` and ``uv_scale`` are about the subject.
@@ -18,7 +25,10 @@ first use.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import threading
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -26,7 +36,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import camera as cam
-from .core.errors import InputError, UserError
+from .core.errors import ApiError, InputError, NoAdapterError, UserError
 from .scene import (
     SHADOW_MODES,
     Camera,
@@ -53,7 +63,8 @@ MAX_RENDERERS = 4
 #: How messages name each argument (``ArgumentError``).
 API_NAMES = {"position": "camera.position", "target": "camera.target", "fov": "camera.fov",
              "view_angle": "camera.view_angle", "height_scale": "height_scale", "uv_scale": "uv_scale",
-             "size": "size", "mode": "mode", "technique": "technique", "filter": "filter", "derivatives": "derivatives"}
+             "size": "size", "mode": "mode", "technique": "technique", "filter": "filter", "derivatives": "derivatives",
+             "material": "material", "shadows": "shadows", "backend": "backend"}
 
 #: The subject's surface normal in its object's frame (before rotation): a plane's and a box's top face, a quad's
 #: front.
@@ -234,6 +245,19 @@ def with_relief(scene: Scene, height_scale=None, uv_scale=None) -> Scene:
     return replace(scene, materials={**scene.materials, name: material})
 
 
+@contextlib.contextmanager
+def _user_errors():
+    """What a call of the API raises for its input is a ValueError: a UserError from below (a scene file, a texture,
+    a map too large) is raised again as an ``ApiError`` with its message; ValueErrors pass as they are."""
+    try:
+        yield
+    except ValueError:
+        raise
+    except UserError as error:
+        raise ApiError(str(error)) from error
+
+
+@_user_errors()
 def scene_of(scene=None, material=None, height_scale=None, uv_scale=None) -> Scene:
     """The Scene a call means: ``scene`` (None: the default scene; a path to a scene TOML; a Scene), with the
     material folder ``material`` on its first plane, and the subject's relief settings (``with_relief``)."""
@@ -245,8 +269,45 @@ def scene_of(scene=None, material=None, height_scale=None, uv_scale=None) -> Sce
         raise InputError(f"scene = {_show(scene)}: expected None (the default scene), a scene .toml path or a "
                          "wgpuviewer.scene.Scene")
     if material is not None:
-        scene = with_folder_material(scene, Path(material).expanduser())
+        scene = _with_material(scene, material)
     return with_relief(scene, height_scale, uv_scale)
+
+
+def _with_material(scene: Scene, material) -> Scene:
+    """``with_folder_material`` of the folder ``material``; its problems (worded for ``--material DIR``) are an
+    ArgumentError naming ``material``."""
+    if isinstance(material, bool) or not isinstance(material, (str, os.PathLike)):
+        raise ArgumentError("material", material, "expected a material folder's path (a str or a pathlib.Path)")
+    folder = Path(material).expanduser()
+    try:
+        return with_folder_material(scene, folder)
+    except UserError as error:
+        reason = str(error).removeprefix(f"--material {folder}: ")
+        raise ArgumentError("material", material, reason.replace("{", "{{").replace("}", "}}")) from None
+
+
+def _backend(backend) -> str | None:
+    """A backend name (None: the environment's, else auto): an ArgumentError naming ``backend`` otherwise."""
+    from .core.gpu import BACKEND_CHOICES
+
+    if backend is not None and (not isinstance(backend, str) or backend.strip().lower() not in BACKEND_CHOICES):
+        raise ArgumentError("backend", backend, f"expected one of {', '.join(BACKEND_CHOICES)}, or None")
+    return backend
+
+
+def _gpu(backend: str | None):
+    """The device of ``backend`` (``core.gpu.get_gpu``); no adapter for a backend asked for is an ArgumentError
+    naming it with the backends this machine offers."""
+    from .core.gpu import get_gpu, offered_backends
+
+    try:
+        return get_gpu(backend)
+    except NoAdapterError as error:
+        offered = offered_backends() if backend is not None else []
+        if not offered:
+            raise ApiError(str(error)) from error
+        raise ArgumentError("backend", backend, f"no GPU adapter found for it (this machine offers {', '.join(offered)})"
+                            f"; give {{backend}} {offered[0]!r} or 'auto'") from None
 
 
 def _size(size) -> tuple[int, int]:
@@ -258,6 +319,7 @@ def _size(size) -> tuple[int, int]:
 
 
 _renderers: list = []  # (scene, gpu, Renderer), the most recently used last
+_cache_lock = threading.RLock()  # the device and renderer caches, shared by the threads that render
 
 
 def renderer_for(scene: Scene, gpu):
@@ -285,29 +347,37 @@ class Prepared:
     camera: Camera
     size: tuple[int, int]
 
+    @_user_errors()
     def image(self, mode: str = "color", camera: Camera | None = None) -> OffscreenImage:
         """The frame drawn offscreen (``Renderer.render``; ``mode`` "albedo" draws the unlit albedo), from
         ``camera`` (None: the prepared one). A frame the adapter cannot allocate is a FrameError naming ``size``."""
         return self.renderer.render(self.draw, self.size, camera or self.camera, mode, size_name="size")
 
 
-def prepare(scene=None, technique=None, size: tuple[int, int] = DEFAULT_SIZE, camera=None, *, material=None,
-            height_scale=None, uv_scale=None, filter: str | None = None, derivatives: str | None = None,
-            shadows: str | None = None, backend: str | None = None, keep: bool = True) -> Prepared:
-    """Everything ``render`` does before it draws (the arguments are ``render``'s; ``technique`` may also be a
-    ``Technique``): every argument checked before the GPU starts, the renderer made (``keep``: the scene's kept
-    renderer, ``renderer_for``; False: one of its own, dropped with the result), the maps the technique needs built
-    (a progress bar on a terminal). ``wgpuviewer render`` and the viewer's offscreen fallback draw through it."""
-    from .core.commands import terminal_progress
-    from .core.gpu import get_gpu
+@dataclass(frozen=True)
+class _Call:
+    """A call's arguments, checked (``_checked``): what ``prepare`` and ``view`` build from."""
+
+    scene: Scene
+    camera: Camera
+    technique: object  # the registry's Technique
+    filtering: dict  # filter, derivatives (registry names) and shadows
+    size: tuple[int, int]
+    backend: str | None
+
+
+def _checked(scene, technique, size, camera, material, height_scale, uv_scale, filter, derivatives, shadows,
+             backend) -> _Call:
+    """Every argument of ``render``/``prepare``/``view`` checked, before the GPU starts: an ArgumentError (or an
+    InputError) naming the first bad one."""
     from .relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, get_derivatives, get_filter
-    from .relief.renderer import Renderer, check_frame_size
     from .techniques import Technique, get_technique
 
     size = _size(size)
     spec = CameraSpec.of(camera)
     if shadows is not None and shadows not in SHADOW_MODES:
-        raise InputError(f"shadows = {_show(shadows)}: expected one of {', '.join(SHADOW_MODES)}, or None")
+        raise ArgumentError("shadows", shadows, f"expected one of {', '.join(SHADOW_MODES)}, or None")
+    backend = _backend(backend)
     scene = scene_of(scene, material, height_scale, uv_scale)
     view = camera_for(scene, spec)
     technique = technique or scene.technique
@@ -316,14 +386,32 @@ def prepare(scene=None, technique=None, size: tuple[int, int] = DEFAULT_SIZE, ca
     filtering = {"filter": _entry("filter", filter or DEFAULT_FILTER, get_filter).name,
                  "derivatives": _entry("derivatives", derivatives or DEFAULT_DERIVATIVES, get_derivatives).name,
                  "shadows": shadows}
-    gpu = get_gpu(backend)
-    check_frame_size(gpu, size, "size")
-    renderer = renderer_for(scene, gpu) if keep else Renderer(scene, gpu)
-    with terminal_progress(f"maps for {technique.name}") as progress:
-        renderer.prepare(technique, progress)
-    return Prepared(renderer, renderer.config(technique, **filtering), view, size)
+    return _Call(scene, view, technique, filtering, size, backend)
 
 
+@_user_errors()
+def prepare(scene=None, technique=None, size: tuple[int, int] = DEFAULT_SIZE, camera=None, *, material=None,
+            height_scale=None, uv_scale=None, filter: str | None = None, derivatives: str | None = None,
+            shadows: str | None = None, backend: str | None = None, keep: bool = True) -> Prepared:
+    """Everything ``render`` does before it draws (the arguments are ``render``'s; ``technique`` may also be a
+    ``Technique``): every argument checked before the GPU starts, the renderer made (``keep``: the scene's kept
+    renderer, ``renderer_for``; False: one of its own, dropped with the result), the maps the technique needs built
+    (a progress bar on a terminal). ``wgpuviewer render`` and the viewer's offscreen fallback draw through it."""
+    from .core.commands import terminal_progress
+    from .relief.renderer import Renderer, check_frame_size
+
+    call = _checked(scene, technique, size, camera, material, height_scale, uv_scale, filter, derivatives, shadows,
+                    backend)
+    with _cache_lock:  # one device per backend and one kept renderer per scene, also when threads ask at once
+        gpu = _gpu(call.backend)
+        check_frame_size(gpu, call.size, "size")
+        renderer = renderer_for(call.scene, gpu) if keep else Renderer(call.scene, gpu)
+    with terminal_progress(f"maps for {call.technique.name}") as progress:
+        renderer.prepare(call.technique, progress)
+    return Prepared(renderer, renderer.config(call.technique, **call.filtering), call.camera, call.size)
+
+
+@_user_errors()
 def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEFAULT_SIZE, camera=None,
            mode: str = "color", *, alpha: bool = False, material=None, height_scale=None, uv_scale=None,
            filter: str | None = None, derivatives: str | None = None, shadows: str | None = None,
@@ -335,14 +423,18 @@ def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEF
     scene's), a dict or a ``CameraSpec`` (position, target, fov, view_angle); ``mode``: one of
     ``relief.output.OUTPUT_MODES`` (``color``: (H, W, 3) float32 sRGB in [0, 1]; the others: float32 data, NaN
     where nothing was drawn); ``alpha``: colour and albedo get a fourth channel, 1 where drawn and 0 on the
-    background (``render --alpha``). ``material``: a material folder shown on the scene's first plane;
-    ``height_scale``, ``uv_scale``: the subject's relief depth and tiling; ``filter``, ``derivatives``: the texture
-    filter and its derivative source (``wgpuviewer filters``); ``shadows``: "off", "hard" or "soft" for every
-    material (``render --shadows``; None: each material's own ``shadows``); ``backend``: auto, vulkan, metal, dx12
-    or gl. A bad argument is an ``ArgumentError`` (an InputError) naming it.
+    background (``render --alpha``). ``material``: a material folder (a str or Path) shown on the scene's first
+    plane; ``height_scale``, ``uv_scale``: the subject's relief depth and tiling; ``filter``, ``derivatives``: the
+    texture filter and its derivative source (``wgpuviewer filters``); ``shadows``: "off", "hard" or "soft" for
+    every material (``render --shadows``; None: each material's own ``shadows``); ``backend``: auto, vulkan, metal,
+    dx12 or gl (None: ``$WGPUVIEWER_BACKEND``, else auto).
+
+    Errors: a bad argument is an ``ArgumentError`` naming it; a problem in a file (the scene, a texture) an
+    ``ApiError`` naming the file and key; both are ValueErrors, checked before the GPU starts where they can be.
 
     The maps a technique needs are built on first use (and cached on disk); the renderer of a scene is kept, so
-    repeated renders of it (other techniques, cameras, modes) cost only the drawing.
+    repeated renders of it (other techniques, cameras, modes) cost only the drawing. Safe from several threads:
+    their frames are drawn one at a time on the device, each correct (the module's docstring says how).
 
     >>> import wgpuviewer
     >>> image = wgpuviewer.render(technique="pom", size=(320, 180), camera={"view_angle": 70})
@@ -359,27 +451,25 @@ def render(scene=None, technique: str | None = None, size: tuple[int, int] = DEF
     return mode_data(prepared.image(mode), mode, alpha)
 
 
+@_user_errors()
 def view(scene=None, technique: str | None = None, size: tuple[int, int] = DEFAULT_WIDGET_SIZE, camera=None, *,
          material=None, height_scale=None, uv_scale=None, filter: str | None = None, derivatives: str | None = None,
          shadows: str | None = None, backend: str | None = None):
     """The interactive viewer (keys, HUD, A/B split) as a Jupyter widget, through rendercanvas's Jupyter backend
     (``jupyter_rfb``): the cell that ends with it shows it, and it draws while a browser shows it. The arguments
-    are ``render``'s; ``size`` is the widget's in logical pixels; ``camera`` is where the viewer's cameras start
-    (R resets to it). Returns the widget (``snapshot()`` gives its last frame as a picture)."""
-    from .relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER
-    from .techniques import get_technique
+    are ``render``'s, checked as ``render`` checks them (before the GPU starts, the same errors); ``size`` is the
+    widget's in logical pixels; ``camera`` is where the viewer's cameras start (R resets to it). Returns the widget
+    (``snapshot()`` gives its last frame as a picture)."""
     from .viewer.app import Viewer
 
-    size = _size(size)
-    spec = CameraSpec.of(camera)
-    scene = scene_of(scene, material, height_scale, uv_scale)
-    name = _entry("technique", technique or scene.technique, get_technique).name
-    scene = replace(scene, camera=camera_for(scene, spec))
-    viewer = Viewer(scene, name, backend, gui="jupyter", size=size, filter=filter or DEFAULT_FILTER,
-                    derivatives=derivatives or DEFAULT_DERIVATIVES, shadows=shadows)
+    call = _checked(scene, technique, size, camera, material, height_scale, uv_scale, filter, derivatives, shadows,
+                    backend)
+    _gpu(call.backend)  # no adapter for the backend: an ArgumentError here, as render raises it
+    scene = replace(call.scene, camera=call.camera)
+    viewer = Viewer(scene, call.technique.name, call.backend, gui="jupyter", size=call.size, **call.filtering)
     viewer.window.request_draw(viewer.draw)  # the widget keeps the viewer alive through its draw function
     return viewer.window.canvas
 
 
-__all__ = ["DEFAULT_SIZE", "ArgumentError", "CameraSpec", "Prepared", "camera_for", "prepare", "render", "scene_of", "subject",
-           "view", "with_relief"]
+__all__ = ["DEFAULT_SIZE", "ApiError", "ArgumentError", "CameraSpec", "Prepared", "camera_for", "prepare", "render",
+           "scene_of", "subject", "view", "with_relief"]

@@ -19,7 +19,8 @@ from wgpuviewer.core.errors import UserError
 #: messages give them (``api_errors``).
 RENDER_OPTIONS = {"position": "--camera", "target": "--target", "fov": "--fov", "view_angle": "--view-angle",
                   "height_scale": "--height-scale", "uv_scale": "--uv-scale", "size": "--size", "mode": "--mode",
-                  "technique": "--technique", "filter": "--filter", "derivatives": "--derivatives"}
+                  "technique": "--technique", "filter": "--filter", "derivatives": "--derivatives",
+                  "material": "--material", "shadows": "--shadows", "backend": "--backend"}
 
 
 def option_label(option: str, value) -> str:

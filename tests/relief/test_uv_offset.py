@@ -1,6 +1,7 @@
 """Large texture coordinates in the renderer. ``uv_offset`` (a material's texture offset in tiles, after
-``uv_scale``) is validated like the other material keys and loses its whole tiles in float64 before anything is
-float32, so a tiled material drawn at an offset of 1e5 tiles matches the same material at offset 0; and each
+``uv_scale``) is validated like the other material keys and, under repeat addressing, loses its whole tiles in
+float64 before anything is float32, so a tiled material drawn at an offset of 1e5 tiles matches the same material at
+offset 0 (under clamp addressing whole tiles move the texture off the face); and each
 fragment's ray search runs on the fraction of its uv, so heavy tiling costs only the uv's own float32 rounding."""
 
 from __future__ import annotations
@@ -85,6 +86,28 @@ def test_the_offset_moves_the_texture_after_the_scale(gpu):
     shift = moved.data[both][:, :2].astype(np.float64) - still.data[both][:, :2]
     assert np.abs(shift - [0.25, 0.5]).max() < 1e-5
     assert np.abs(moved.color.astype(int) - still.color.astype(int))[both].max() > 32  # the bricks moved
+
+
+def clamped(offset: str):
+    """The default 2x2 plane of bricks under clamp addressing, at ``offset`` (TOML)."""
+    lines = f"albedo = {BRICKS}\nheight = {BRICKS}\nheight_scale = 0.06\naddress = \"clamp\"\nuv_offset = {offset}\n"
+    return parse_scene(material_scene(["basic"], lines, position=(0.0, 1.6, 1.2)))
+
+
+@pytest.mark.requires_gpu
+def test_under_clamp_the_whole_offset_moves_the_texture_off_the_face(gpu):
+    """Clamp addressing has one tile, the uv square: whole tiles of the offset count. [0.5, 0] moves the uv by half
+    a tile, the half of the face beyond the square discarded; [1, 0] moves all of it off the face (with repeat
+    addressing both are whole-tile-free: [1, 0] draws what [0, 0] draws)."""
+    still, half, whole = (Renderer(clamped(o), gpu).render("basic", SIZE) for o in ("[0.0, 0.0]", "[0.5, 0.0]",
+                                                                                    "[1.0, 0.0]"))
+    assert still.covered.mean() > 0.3
+    assert not whole.covered.any()
+    both = still.covered & half.covered
+    assert 0.3 < half.covered.sum() / still.covered.sum() < 0.7
+    shift = half.data[both][:, :2].astype(np.float64) - still.data[both][:, :2]
+    assert np.abs(shift - [0.5, 0.0]).max() < 1e-5
+    assert (half.data[half.covered][:, 0] <= 1.0).all()
 
 
 def tiled_plane(size: float, tiles: float, centre, eye, target) -> str:

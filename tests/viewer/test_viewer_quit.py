@@ -1,16 +1,20 @@
 """Quitting the viewer, each run a subprocess under the virtual display: Escape at the start of a script, in its
 middle, and in the A/B split after an in-place distance-map build; Escape and the window manager's close button
-while a distance map builds in the background. Every run ends by itself with exit 0 (a crash is exit -11), no ERROR
-line and no traceback; no frame is drawn after Escape, a background build stops after the map it is building, and
-the window's surface is released with the window (not by the garbage collector at exit). The scene is tiny (a
-32x32 height map) so that each run takes seconds."""
+while a distance map builds in the background; SIGINT and SIGTERM at random moments (seeded), interactive and
+scripted. Every Escape run ends by itself with exit 0 (a crash is exit -11), no ERROR line and no traceback; no frame
+is drawn after Escape, a background build stops after the map it is building, and the window's surface is released
+with the window (not by the garbage collector at exit); a signal ends a run with 130 or 143, no panic, no temp left.
+The scene is tiny (a 32x32 height map) so that each run takes seconds."""
 
 from __future__ import annotations
 
 import json
 import os
+import random
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -28,10 +32,10 @@ def scene(tmp_path_factory):
     return path
 
 
-def run(args, display, tmp_path):
+def run(args, display, tmp_path, code: int = 0):
     env = {**os.environ, "DISPLAY": display, "WGPUVIEWER_CONFIG_DIR": str(tmp_path / "config")}
     result = subprocess.run(args, capture_output=True, text=True, timeout=120, env=env, cwd=tmp_path)
-    assert result.returncode == 0, (result.returncode, result.stderr)
+    assert result.returncode == code, (result.returncode, result.stderr)
     errors = [line for line in result.stderr.splitlines() if line.startswith("ERROR")]
     assert not errors and "Traceback" not in result.stderr, result.stderr
     return result
@@ -43,12 +47,55 @@ def run(args, display, tmp_path):
     ("B,Tab,9,Escape", 3),  # in the A/B split, after B's distance map was built in place
 ])
 def test_escape_ends_a_script_with_exit_0(scene, display, adapter, tmp_path, keys, drawn):
-    shot = tmp_path / "shot.png"
     frames = len(keys.split(",")) + 3
     result = run([sys.executable, "-c", RUNNER, "view", str(scene), "--technique", "basic", "--keys", keys,
-                  "--size", "160x100", "--screenshot", str(shot)], display, tmp_path)
-    assert f"wgpuviewer: the window was closed after {drawn} of {frames} frames; {shot} not written" in result.stderr
+                  "--size", "160x100"], display, tmp_path)
+    assert f"wgpuviewer: the window was closed after {drawn} of {frames} frames\n" in result.stderr
+
+
+def test_a_screenshot_that_escape_left_unwritten_is_exit_2(scene, display, adapter, tmp_path):
+    shot = tmp_path / "shot.png"
+    result = run([sys.executable, "-c", RUNNER, "view", str(scene), "--technique", "basic", "--keys", "Escape,2",
+                  "--size", "160x100", "--screenshot", str(shot)], display, tmp_path, code=2)
+    assert result.stderr.strip().splitlines()[-1] == (
+        f"wgpuviewer: error: --screenshot {shot} not written: the window was closed after 0 of 5 frames; drop Escape "
+        "from --keys, or give --frames the number of frames before it")
     assert not shot.exists()
+
+
+#: (signal, exit code, scripted) of the runs a signal ends, each at a random moment from the start (seeded).
+SIGNALLED = [(signal.SIGINT, 130, False), (signal.SIGTERM, 143, False), (signal.SIGINT, 130, True),
+             (signal.SIGTERM, 143, True)]
+
+
+#: The CLI, saying on stdout when it is about to run the command (its handlers set from there on).
+STARTED = RUNNER.replace("sys.exit(main(", "print('started', flush=True); sys.exit(main(")
+
+
+@pytest.mark.parametrize(("sig", "code", "scripted"), SIGNALLED)
+def test_a_signal_at_a_random_moment_ends_the_viewer_as_escape_does(scene, display, adapter, tmp_path, sig, code,
+                                                                    scripted):
+    """SIGINT/SIGTERM while the window opens, draws or dispatches glfw's callbacks (a random moment after the
+    command starts, seeded), interactive and scripted: exit 130/143 with one line, no wgpu-native panic or abort, no
+    traceback, nothing of wgpuviewer's left in the temp folder."""
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    env = {**os.environ, "DISPLAY": display, "WGPUVIEWER_CONFIG_DIR": str(tmp_path / "config"), "TMPDIR": str(temp)}
+    args = [sys.executable, "-c", STARTED, "view", str(scene), "--technique", "basic", "--size", "160x100",
+            *(["--frames", "100000"] if scripted else [])]
+    process = subprocess.Popen(args, env=env, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert process.stdout.readline() == "started\n"
+        time.sleep(random.Random(f"{sig}{scripted}").uniform(0.1, 2.5))
+        process.send_signal(sig)
+        err = process.communicate(timeout=60)[1]
+    finally:
+        process.kill()
+    assert process.returncode == code, (process.returncode, err)
+    assert "panicked" not in err and "Traceback" not in err, err
+    assert err.strip().splitlines()[-1] == f"wgpuviewer: {'interrupted' if code == 130 else 'terminated'}", err
+    left = [p.name for p in temp.iterdir() if not p.name.startswith("wgpuviewer-runtime-")]  # the driver's, kept
+    assert left == [], left
 
 
 # A background build of the distance technique's maps (normal, depth, distance) that is under way when the window

@@ -17,6 +17,7 @@ read-back). This module holds the draw: each configuration's bind groups and the
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -42,7 +43,7 @@ from .filters import (
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding, depth_range
 from .material_textures import depth_data, derived_texture, height_size, material_texture, reported_against
 from .pipelines import Pipelines, module
-from .shaders import FRAME, PLAIN, MaterialVariant, pack_trace_params, trace_params_size, traces_relief
+from .shaders import FRAME, PLAIN, MaterialVariant, material_variant, pack_trace_params, trace_params_size
 from .targets import (
     OFFSCREEN_FORMATS,
     OffscreenFrame,
@@ -115,6 +116,7 @@ class Renderer:
         self.scene = scene
         self.gpu = gpu
         self.created: list[str] = []  # GPU resources built, in order: "kind:name"
+        self._building = threading.Lock()  # prepare: one thread builds the maps, others wait for them
         self._material_groups: OrderedDict[tuple, tuple[wgpu.GPUBindGroup, wgpu.GPUBuffer]] = OrderedDict()
         self._filter_groups: dict[tuple, wgpu.GPUBindGroup] = {}
         if like is not None:
@@ -162,6 +164,10 @@ class Renderer:
         """Build every texture ``technique`` needs now (loading files, deriving maps), reporting each step as
         ``progress(label, done, total)``: what ``render``/``encode`` would otherwise build on first use. The
         viewer calls it from a worker thread while it keeps drawing; problems raise UserError naming the key."""
+        with self._building:  # threads preparing one renderer build each map once
+            self._prepare(technique, progress)
+
+    def _prepare(self, technique: Technique | str, progress: Callable[[str, int, int], None] | None) -> None:
         todo = self.missing(technique)
         for material, kind in todo:  # all refused before any is loaded or generated
             self.check_map(material, kind)
@@ -261,13 +267,12 @@ class Renderer:
 
     def variant(self, material_name: str, technique: Technique, draw: DrawConfig) -> MaterialVariant:
         """The material variant a material is drawn with: its ``shadows`` and ``depth_offset`` (the draw's overrides
-        first) and ``address``; shadows and the hit's depth only where the technique traces the relief."""
+        first) and ``address``; shadows and the hit's depth only where the technique traces the relief; the technique's code
+        paths the material's parameters run (``shaders.material_variant``)."""
         material = self.scene.materials[material_name]
-        traced = traces_relief(technique)
         shadows = material.shadows if draw.shadows is None else draw.shadows
         depth_offset = material.depth_offset if draw.depth_offset is None else draw.depth_offset
-        return MaterialVariant(shadows if traced else "off", depth_offset and traced,
-                               material.address == "clamp")
+        return material_variant(technique, material, draw.values, shadows, depth_offset)
 
     def pipeline(self, technique: Technique, formats: tuple[str, ...], filter: str = DEFAULT_FILTER,
                  derivatives: str = DEFAULT_DERIVATIVES, mode: str = "color",
@@ -372,14 +377,19 @@ class Renderer:
         statistics (every output mode is made from them: ``relief.output``). ``draw``: a DrawConfig, or a technique
         (an entry or its name: drawn with the scene's parameters for it). ``mode`` "albedo" makes the colour the
         filtered albedo, unlit; every other mode reads the shaded colour. A frame too large for the adapter
-        (``check_frame_size``, or its memory) is a FrameError naming ``size_name``."""
+        (``check_frame_size``, or its memory) is a FrameError naming ``size_name``. Safe from several threads:
+        frames on one device are drawn one at a time (``Gpu.lock``)."""
         if not isinstance(draw, DrawConfig):
             draw = self.config(draw)
         check_frame_size(self.gpu, size, size_name)
-        frame = OffscreenFrame(self.gpu, size, size_name)
-        encoder = self.gpu.device.create_command_encoder(label="offscreen")
-        views, depth = frame.views()
-        self.encode(encoder, views, depth, OFFSCREEN_FORMATS, draw, camera or self.scene.camera, size,
-                    "albedo" if mode == "albedo" else "color")
-        self.gpu.device.queue.submit([encoder.finish()])
-        return frame.read(draw.technique.layer_range(draw.values))
+        # The frame and params uniforms are the renderer's, written by encode and read when the submit runs: a
+        # draw of another thread in between would change this one's camera. The device's lock holds the whole
+        # frame, from the writes to the read-back.
+        with self.gpu.lock:
+            frame = OffscreenFrame(self.gpu, size, size_name)
+            encoder = self.gpu.device.create_command_encoder(label="offscreen")
+            views, depth = frame.views()
+            self.encode(encoder, views, depth, OFFSCREEN_FORMATS, draw, camera or self.scene.camera, size,
+                        "albedo" if mode == "albedo" else "color")
+            self.gpu.device.queue.submit([encoder.finish()])
+            return frame.read(draw.technique.layer_range(draw.values))

@@ -56,9 +56,10 @@ def hit_depth_outputs(outputs: FragmentOutputs) -> Generated:
     return Generated(f"<generated: struct {name}>", "\n".join(lines) + "\n")
 
 
-class FrameError(UserError):
+class FrameError(UserError, ValueError):
     """A frame the adapter cannot make, draw or read back. ``str()`` names the size by ``size_name``;
-    ``named(name)`` is the same message naming it otherwise (a caller's own option)."""
+    ``named(name)`` is the same message naming it otherwise (a caller's own option). A ValueError too: the Python
+    API raises it as it is (its ``size``)."""
 
     def __init__(self, template: str, size_name: str):
         self.template = template  # the message, "{size}" where the size's name goes

@@ -1,15 +1,17 @@
 """Turntables: a scene filmed by a camera orbiting its target, one full turn in N frames, written as an animated GIF
-(imageio) or an MP4 (H.264 through the ffmpeg that imageio-ffmpeg ships), atomically.
+(pillow) or an MP4 (H.264 through the ffmpeg that imageio-ffmpeg ships), atomically. Frames stream: an MP4's go to
+ffmpeg as they are rendered, a GIF's are held quantised (one byte a pixel) until pillow encodes them.
 
 The orbit turns the whole camera (position and up vector) about the vertical axis (+y, the viewer's up) through the
 camera's target, counter-clockwise seen from above: frame 0 is the camera itself and frame N would be it again, so
-the clip loops without a seam. The lights stay where the scene puts them. Both writers are optional dependencies
+the clip loops without a seam. The lights stay where the scene puts them. The MP4 writer is an optional dependency
 (``pip install 'wgpuviewer[turntable]'``); every check (suffix, frame count, size, memory, a writer missing) comes
 before the GPU starts.
 """
 
 from __future__ import annotations
 
+import io
 import math
 import tempfile
 from collections.abc import Callable, Iterable, Iterator
@@ -26,13 +28,17 @@ from .output import mode_picture
 from .renderer import DrawConfig, Renderer
 
 #: What each suffix is written with: (the module imported, the package that provides it).
-WRITERS = {".gif": ("imageio", "imageio"), ".mp4": ("imageio_ffmpeg", "imageio-ffmpeg")}
+WRITERS = {".gif": ("PIL", "pillow"), ".mp4": ("imageio_ffmpeg", "imageio-ffmpeg")}
 #: Frames per second of both formats (a GIF's delay is whole hundredths of a second: 4 at 25 fps).
 FPS = 25
 #: A turn needs two frames to move at all; 3600 is two and a half minutes at 25 fps.
 FRAME_RANGE = (2, 3600)
 #: The GIF writer holds every frame in memory until it encodes them; a larger clip is refused up front.
 GIF_MEMORY_LIMIT = 2 << 30
+#: Bytes a GIF turntable holds per pixel of every frame at its peak: the quantised frames (one byte), the encoded
+#: clip and pillow's working copies (measured: 3.9 for frames of noise, the largest GIFs; ``tests/relief/
+#: test_turntable.py`` holds the peak under this).
+GIF_BYTES_PER_PIXEL = 5
 INSTALL = "pip install 'wgpuviewer[turntable]'"
 
 
@@ -50,7 +56,7 @@ def check_turntable(path, frames: int, size: tuple[int, int], option: str = "--o
     if suffix == ".mp4" and (w % 2 or h % 2):
         raise UserError(f"--size {w}x{h}: an MP4 (H.264, 4:2:0) needs an even width and height, e.g. "
                         f"{w + w % 2}x{h + h % 2}")
-    held = w * h * 3 * frames
+    held = w * h * GIF_BYTES_PER_PIXEL * frames
     if suffix == ".gif" and held > GIF_MEMORY_LIMIT:
         raise UserError(f"{option} {frames} at --size {w}x{h}: a GIF holds every frame in memory "
                         f"({held / 2**30:.1f} GiB, more than {GIF_MEMORY_LIMIT / 2**30:g} GiB); use fewer frames, "
@@ -99,10 +105,15 @@ def write_turntable(path, pictures: Iterable[np.ndarray], size: tuple[int, int])
 
 
 def _gif(pictures: Iterable[np.ndarray]) -> bytes:
-    import imageio.v3 as iio
+    from PIL import Image
 
-    # loop=0: play forever; each frame's own palette (pillow quantises per frame).
-    return iio.imwrite("<bytes>", np.stack(list(pictures)), extension=".gif", duration=1000 / FPS, loop=0)
+    # Each picture is quantised to its own 256-colour palette as it comes (what pillow's GIF writer does to an RGB
+    # frame), so the clip is held at one byte a pixel (GIF_BYTES_PER_PIXEL), never as RGB frames.
+    frames = [Image.fromarray(picture).convert("P", palette=Image.Palette.ADAPTIVE) for picture in pictures]
+    out = io.BytesIO()
+    # loop=0: play forever.
+    frames[0].save(out, format="GIF", save_all=True, append_images=frames[1:], duration=1000 / FPS, loop=0)
+    return out.getvalue()
 
 
 def _mp4(pictures: Iterable[np.ndarray], size: tuple[int, int]) -> bytes:

@@ -49,12 +49,21 @@ def object_data(obj, material) -> bytes:
     normal_matrix = np.eye(4)
     normal_matrix[:3, :3] = np.linalg.inv(model[:3, :3]).T
     return OBJECT.pack({"model": cam.to_wgsl(model), "normal_matrix": cam.to_wgsl(normal_matrix),
-                        "uv_transform": [*material.uv_scale, *offset_fraction(material.uv_offset)]})
+                        "uv_transform": [*material.uv_scale, *uv_offset(material)]})
+
+
+def uv_offset(material) -> tuple[float, float]:
+    """The offset a material's uv gets on the GPU: under repeat addressing its fraction (``offset_fraction``);
+    under clamp addressing the offset as it is, since there the uv square is the relief's one tile and a whole
+    tile moves the texture off the face (its pixels are discarded)."""
+    if material.address == "clamp":
+        return tuple(float(x) for x in material.uv_offset)
+    return offset_fraction(material.uv_offset)
 
 
 def offset_fraction(uv_offset: tuple[float, float]) -> tuple[float, float]:
     """``Material.uv_offset`` less its whole tiles, in float64 (``x - floor(x)``: exact for x >= 0, within 2^-53
-    below), in [0, 1]. The materials repeat, so whole tiles move nothing; what reaches the GPU's float32 is the
+    below), in [0, 1]. Repeating materials move nothing by whole tiles; what reaches the GPU's float32 is the
     fraction alone, and an offset of 1e5 tiles draws exactly what its fraction draws."""
     offset = np.asarray(uv_offset, np.float64)
     return tuple(float(x) for x in offset - np.floor(offset))

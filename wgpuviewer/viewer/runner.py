@@ -4,15 +4,23 @@ Scripted runs (tests, demos): ``frames`` frames, ``keys`` played one frame each 
 a time, ``W:0.5``, takes as many frames as ``keys.parse_script`` gives it), the last frame (HUD included) saved to
 ``screenshot``; an ERROR logged while drawing makes the run exit 1, an error inside a frame ends it (exit 2 for a
 UserError). A key that closes the window (Escape) ends the script: no frame is drawn once the window is closing, even
-when the toolkit asks for one more, a run closed before its last frame says so (and writes no screenshot), and a map
-build under way stops before the run returns. A window that gives no frame to draw into (wgpu-py cancels the frame:
-a surface lost for good, a zero-size window) ends a scripted run after ``STALL_FRAMES`` cancelled frames and
-``STALL_SECONDS``, with one line (exit 2), instead of waiting forever; an interactive run waits (a minimised window).
+when the toolkit asks for one more, a run closed before its last frame says so (one line; exit 2 when the screenshot
+it was to write is not written), and a map build under way stops before the run returns.
+
+SIGINT (Ctrl-C) and SIGTERM end a run, interactive or scripted, as Escape does, with exit 130 and 143
+(``QUIT_SIGNALS``): from the moment the window opens their handler only notes the signal, and the window's loop closes
+it (``Window.run``, ``SignalQuit``), never from inside a draw or a toolkit callback (a surface destroyed during a draw
+is a wgpu-native panic; a KeyboardInterrupt raised inside a glfw callback is lost).
+
+A window that gives no frame to draw into (wgpu-py cancels the frame: a surface lost for good, a zero-size window)
+ends a scripted run after ``STALL_FRAMES`` cancelled frames and ``STALL_SECONDS``, with one line (exit 2), instead of
+waiting forever; an interactive run waits (a minimised window).
 """
 
 from __future__ import annotations
 
 import logging
+import signal
 import sys
 import time
 from pathlib import Path
@@ -24,12 +32,15 @@ from wgpuviewer.core.io import refuse_directory
 from wgpuviewer.relief.output import save_rgb_png
 
 from .keys import parse_script
+from .window import SignalQuit
 
 #: The loggers whose ERRORs fail a scripted run.
 LOGGERS = ("wgpu", "rendercanvas")
 #: A scripted run ends when this many frames in a row were cancelled over at least this long since the last drawn.
 STALL_FRAMES = 30
 STALL_SECONDS = 10.0
+#: The signals that end a run as Escape does, with the exit code and the line each gives (as ``core.commands``).
+QUIT_SIGNALS = {signal.SIGINT: (130, "interrupted"), signal.SIGTERM: (143, "terminated")}
 
 
 def scripted_frames(frames: int | None, screenshot: str | None, keys) -> int | None:
@@ -107,18 +118,29 @@ def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=(
             window.close()
 
     window.request_draw(frame)
+    signalled = None
     try:
         window.run()
+    except SignalQuit as quit:
+        signalled = quit.signum
     finally:
         viewer.stop_builds()
         for name in LOGGERS:
             logging.getLogger(name).removeHandler(errors)
+    if signalled is not None:
+        code, said = QUIT_SIGNALS[signalled]
+        print(f"wgpuviewer: {said}", file=sys.stderr)
+        return code
     if "error" in state:
         raise state["error"]
     if frames is not None and state["frame"] < frames:
-        skipped = f"; {screenshot} not written" if screenshot else ""
-        print(f"wgpuviewer: the window was closed after {state['frame']} of {frames} frames{skipped}", file=sys.stderr)
+        closed = f"the window was closed after {state['frame']} of {frames} frames"
+        if screenshot:  # what the script was for is missing
+            raise UserError(f"--screenshot {screenshot} not written: {closed}; drop Escape from --keys, or give "
+                            "--frames the number of frames before it")
+        print(f"wgpuviewer: {closed}", file=sys.stderr)
     if frames is not None and errors.count:
         print(f"wgpuviewer: error: {errors.count} error(s) logged while drawing", file=sys.stderr)
         return 1
     return 0
+

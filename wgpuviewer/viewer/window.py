@@ -9,9 +9,15 @@ A window opens only on an adapter that can present to it (``Window._check_surfac
 adapter cannot use is a wgpu-native panic, which aborts the process, so that case is one line instead (``refusal``:
 the backend, why, and the backends and the offscreen render that work). A surface whose textures cannot be read back
 (OpenGL's: no COPY_SRC) gets frames drawn into a texture of the window's own, copied onto it (``Present``).
+
+From the moment a window opens until its loop ends, SIGINT and SIGTERM only note themselves (``Window.note_signals``);
+the loop closes the window for them and ``Window.run`` raises ``SignalQuit`` after it (the runner's exit 130/143).
 """
 
 from __future__ import annotations
+
+import signal
+import threading
 
 import wgpu
 
@@ -24,6 +30,18 @@ from wgpuviewer.core.wgsl import compose
 BACKEND_NAMES = {kind: name for name, kind in BACKENDS.items()}
 #: What the window's frames are used for: drawn into, and read back (scripted runs, P).
 FRAME_USAGE = wgpu.TextureUsage.RENDER_ATTACHMENT | wgpu.TextureUsage.COPY_SRC
+#: The signals a window of its own (not a notebook's) notes instead of raising (``Window.note_signals``).
+NOTED_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+#: How often the event loop looks for a noted signal (the window may draw no frames: minimised).
+POLL_SECONDS = 0.05
+
+
+class SignalQuit(Exception):
+    """The window's loop ended for a signal (``Window.run``): ``signum``."""
+
+    def __init__(self, signum: int):
+        super().__init__(f"signal {signum}")
+        self.signum = signum
 
 
 def toolkit(gui: str):
@@ -80,6 +98,19 @@ class Window:
     def __init__(self, gui: str, gpu, size: tuple[int, int], *, scripted: bool, vsync: bool):
         RenderCanvas, self._loop = toolkit(gui)
         self.gui = gui
+        #: SIGINT or SIGTERM once one came in (``note_signals``); the run loop ends the run for it (``runner``).
+        self.quit_signal = None
+        # From before the toolkit's window exists: its callbacks run from here on, and an exception a signal raises
+        # inside one is lost (glfw's ctypes callbacks), so the window would stay open.
+        self._signal_handlers = self.note_signals() if gui != "jupyter" else {}
+        try:
+            self._open(RenderCanvas, gpu, size, scripted, vsync)
+        except BaseException:
+            self.restore_signals()
+            raise
+
+    def _open(self, RenderCanvas, gpu, size, scripted: bool, vsync: bool) -> None:  # noqa: N803 -- a class
+        """The canvas, its surface checked and configured."""
         self._device = gpu.device
         self.canvas = RenderCanvas(
             title="wgpuviewer", size=size, update_mode="continuous", max_fps=1000 if scripted else 240, vsync=vsync,
@@ -156,8 +187,44 @@ class Window:
         self.canvas.request_draw(draw_and_copy)
 
     def run(self) -> None:
-        """The event loop, until the window closes."""
-        self._loop.run()
+        """The event loop, until the window closes. A signal noted meanwhile (``note_signals``) closes the window
+        from the loop, as Escape does (never from inside a draw or a toolkit callback, where closing would destroy
+        the surface under way: a wgpu-native panic), and is raised after the loop as ``SignalQuit``; the handlers
+        from before the window opened are back by then. rendercanvas sets its own SIGINT handler (which closes the
+        window wherever the signal lands) when its loop starts: the loop's first callback notes the signals again."""
+
+        def poll():
+            if self.quit_signal is not None and not self.closed:
+                self.close()
+            if not self.closed:
+                self._loop.call_later(POLL_SECONDS, poll)
+
+        self._loop.call_soon(self.note_signals)
+        self._loop.call_soon(poll)
+        try:
+            self._loop.run()
+        finally:
+            self.restore_signals()
+        if self.quit_signal is not None:
+            raise SignalQuit(self.quit_signal)
+
+    def note_signals(self) -> dict:
+        """From now on NOTED_SIGNALS only set ``quit_signal`` (a handler that does nothing else may land anywhere:
+        inside a draw, inside a toolkit callback); returns the handlers they had. The main thread only (elsewhere
+        nothing changes)."""
+        if threading.current_thread() is not threading.main_thread():
+            return {}
+
+        def note(signum, _frame):
+            self.quit_signal = signum
+
+        return {sig: signal.signal(sig, note) for sig in NOTED_SIGNALS}
+
+    def restore_signals(self) -> None:
+        """The handlers NOTED_SIGNALS had before the window opened, back."""
+        for sig, handler in self._signal_handlers.items():
+            signal.signal(sig, handler)
+        self._signal_handlers = {}
 
     def close(self) -> None:
         """Close the window from the event loop, once the draw or toolkit callback under way has returned: closing
