@@ -62,7 +62,7 @@ def graph() -> dict[str, set[str]]:
 #: What each room may import (docs/architecture.md, "The rooms"). A folder room (one technique, one map kind, one
 #: study) is its kind plus its folder name: it never imports another folder of its kind, only the shared modules
 #: around them ("techniques", "maptools", "harness").
-PRODUCT = {"core", "maptools", "map kind", "techniques", "technique", "scene", "relief", "viewer", "api"}
+PRODUCT = {"core", "maptools", "map kind", "techniques", "technique", "scene", "relief", "viewer", "api", "export"}
 RULES = {
     "core": set(),
     "maptools": {"core", "map kind"},  # the registry finds the kinds; the CLI, cache and check use them
@@ -73,6 +73,7 @@ RULES = {
     "relief": {"core", "maptools", "map kind", "techniques", "scene"},
     "viewer": {"core", "maptools", "map kind", "techniques", "scene", "relief"},
     "api": {"core", "techniques", "scene", "relief", "viewer"},
+    "export": {"core", "techniques", "relief", "maptools"},  # a technique's module for other renderers, its maps
     "harness": {"core"},
     "bench": PRODUCT | {"harness"},
     "study": PRODUCT | {"harness", "bench"},
@@ -96,7 +97,7 @@ def room(name: str) -> tuple[str, str]:
         return ("technique", folder) if folder else ("techniques", "")
     if top in ("scene", "textures", "meshes", "camera"):
         return "scene", ""
-    if top in ("core", "relief", "viewer", "api"):
+    if top in ("core", "relief", "viewer", "api", "export"):
         return top, ""
     return "front", ""  # the package itself, cli, __main__ and the documented re-exports: anything
 

@@ -20,6 +20,7 @@ from wgpuviewer.core.commands import (
 )
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import refuse_directory
+from wgpuviewer.export.command import register as register_export
 
 from .cli_render import api_errors, prepare_render, render_orbit, save_render
 
@@ -104,6 +105,8 @@ def cmd_view(args) -> int:
     from wgpuviewer.viewer.settings import load_settings
 
     keys = [k for k in args.keys.split(",") if k] if args.keys else []
+    if args.keys is not None and not keys:
+        raise UserError(f"--keys {args.keys!r}: no keys given; expected comma-separated keys, e.g. 2,3,ArrowRight")
     # The script is checked first: before the scene loads, the GPU starts or a display is looked for.
     scripted = scripted_frames(args.frames, args.screenshot, keys) is not None
     window = has_display()
@@ -378,6 +381,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
 
     add_view_command(sub)
     add_render_command(sub)
+    register_export(sub)
 
     warm_ = sub.add_parser("warm", help="build every map a scene's techniques need into the map cache, now")
     warm_.add_argument("scene", nargs="?", metavar="SCENE|DIR",
