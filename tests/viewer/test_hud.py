@@ -14,7 +14,7 @@ from imgui_bundle import imgui
 
 from wgpuviewer.relief.filters import DERIVATIVE_SOURCES, FILTERS
 from wgpuviewer.techniques import TECHNIQUES
-from wgpuviewer.viewer.hud import font_path, summary_line
+from wgpuviewer.viewer.hud import budget_line, font_path, summary_line
 from wgpuviewer.viewer.keys import CONTROLS
 from wgpuviewer.viewer.state import ViewerState
 from wgpuviewer.viewer.stats import Summary
@@ -30,7 +30,19 @@ def printed_texts() -> list[str]:
     texts += [d.description for d in DERIVATIVE_SOURCES.values()]
     state = ViewerState.start(list(TECHNIQUES), "pom", next(iter(FILTERS)), next(iter(DERIVATIVE_SOURCES)))
     texts += [state.key_for(name) for name in TECHNIQUES]
-    return texts + ["0.0-12.5°: pom", summary_line("A", Summary(1.5, 3.0), "texels")]
+    budgets = [budget_line(name, {**t.defaults(), **extra}) for name, t in TECHNIQUES.items()
+               for extra in ({}, {"max_error_px": 0.5})]
+    return texts + ["0.0-12.5°: pom", summary_line("A", Summary(1.5, 3.0), "texels"), *filter(None, budgets)]
+
+
+def test_the_hud_shows_the_pixel_budget_of_a_technique_that_has_one():
+    budgeted = [name for name, t in TECHNIQUES.items() if "max_error_px" in {p.name for p in t.params}]
+    assert "auto" in budgeted
+    auto = TECHNIQUES["auto"].defaults()
+    assert budget_line("auto", {**auto, "max_error": 1.0, "max_error_px": 0.5}) == \
+        "pixel budget 0.5 px (at least 1 texel)"
+    assert budget_line("auto", {**auto, "max_error": 0.5, "max_error_px": 0.0}).startswith("pixel budget off")
+    assert budget_line("pom", TECHNIQUES["pom"].defaults()) is None
 
 
 @pytest.fixture()

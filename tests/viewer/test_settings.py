@@ -41,7 +41,8 @@ def test_missing_file_gives_defaults_silently(config):
 
 def test_round_trip_and_atomic_write(config):
     wanted = Settings(width=800, height=600, fullscreen=True, vsync=False, camera_mode="orbit", move_speed=3.25,
-                      look_sensitivity=0.002, last_scene='C:\\scenes\\"odd" name.toml', last_technique="pom")
+                      look_sensitivity=0.002, last_scene='C:\\scenes\\"odd" name.toml', last_technique="pom",
+                      render_scale="0.5")
     assert save_settings(wanted) == config
     assert load_settings() == (wanted, [])
     assert [p.name for p in config.parent.iterdir()] == ["settings.toml"]  # no temporary file left behind
@@ -69,11 +70,12 @@ def test_corrupt_or_outdated_file_gives_defaults_and_a_warning(config, text, war
 def test_bad_values_fall_back_one_by_one(config):
     config.write_text(
         f"version = {st.VERSION}\nwidth = 800\nheight = -5\nvsync = 'yes'\ncamera_mode = 'spin'\n"
-        "move_speed = nan\nlook_sensitivity = 0.01\nshiny = true\n"
+        "move_speed = nan\nlook_sensitivity = 0.01\nshiny = true\nrender_scale = '0.6'\n"
     )
     settings, warnings = load_settings()
     assert settings == Settings(width=800, look_sensitivity=0.01)
-    assert len(warnings) == 5
+    assert len(warnings) == 6
+    assert any("render_scale = '0.6': expected one of auto, 1, 0.75" in w for w in warnings)
     assert any("height = -5: out of range" in w for w in warnings)
     assert any("unknown setting 'shiny'" in w for w in warnings)
 

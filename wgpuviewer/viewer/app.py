@@ -44,6 +44,7 @@ from .cameras import FlyCamera, OrbitCamera
 from .frames import FrameEncoder
 from .input import Input
 from .keys import PRESSED, TECHNIQUE_KEYS
+from .render_scale import AutoScale, Upscaler, next_choice, scaled_size
 from .settings import LIMITS, Settings, save_session
 from .state import Half, ViewerState
 from .stats import FrameStats, GpuTimer, Summary, half_summaries, split_column
@@ -102,6 +103,10 @@ class Viewer:
         self.error_range = 2.0
         self.frame_size = (0, 0)
         self.scripted = scripted
+        #: The render scale (U): 'auto' or a fixed scale; auto chooses on a software adapter in interactive runs.
+        self.render_choice = s.render_scale
+        self.auto_scale = AutoScale() if self.gpu.software and not scripted else None
+        self.upscaler: Upscaler | None = None  # built when a scale below 1 is first drawn
         self.window = Window(gui, self.gpu, size or (s.width, s.height), scripted=scripted, vsync=self.vsync)
         self.window.on_closing(self.builds.cancel)  # a map build stops as soon as the window closes
         self._last_time = time.perf_counter()
@@ -342,6 +347,26 @@ class Viewer:
     def reload_shaders(self, key: str):
         self.reloader.reload()
 
+    def cycle_render_scale(self, key: str):
+        self.render_choice = next_choice(self.render_choice)
+        self.message(f"render scale: {self.render_scale_label}")
+
+    @property
+    def render_scale(self) -> float:
+        """The fraction of the window's size the scene is drawn at (the HUD is always drawn at full size)."""
+        if self.render_choice != "auto":
+            return float(self.render_choice)
+        return self.auto_scale.scale if self.auto_scale else 1.0
+
+    @property
+    def render_scale_label(self) -> str:
+        """E.g. '0.5 (auto: 6.1 fps at 1)', '1 (auto)' or '0.75'."""
+        auto = self.auto_scale
+        if self.render_choice != "auto":
+            return self.render_choice
+        measured = f": {auto.fps:.1f} fps at {auto.measured_at:g}" if auto and auto.fps else ""
+        return f"{self.render_scale:g} (auto{measured})"
+
     def quit(self, key: str):
         self.window.close()
 
@@ -351,15 +376,21 @@ class Viewer:
 
     def _update_title(self):
         what = " | ".join(f"{h.technique} {h.filter} ({h.derivatives})" for _, h in self.state.shown())
-        self.window.set_title(f"wgpuviewer - {self.scene.name} - {what} ({self.mode})")
+        scale = f", render scale {self.render_scale:g}" if self.render_scale != 1.0 else ""
+        self.window.set_title(f"wgpuviewer - {self.scene.name} - {what} ({self.mode}{scale})")
 
     # --- frames ------------------------------------------------------------------------------
 
     def draw(self):
         self.builds.poll()
         now = time.perf_counter()
-        dt, self._last_time = min(now - self._last_time, 0.1), now
+        seconds, self._last_time = now - self._last_time, now
+        dt = min(seconds, 0.1)
         self.stats.tick(now)
+        if self.render_choice == "auto" and self.auto_scale and self.builds.current is None \
+                and self.auto_scale.add(seconds):
+            self.message(f"render scale: {self.render_scale_label}")
+            self._update_title()
         if self.timer:
             for ms in self.timer.collect():
                 self.stats.add_gpu_time(ms)
@@ -371,11 +402,16 @@ class Viewer:
             if not self._shown_errors:
                 self.message("shaders reloaded")
         self.input.fly(dt)
-        texture = self.window.current_texture()
-        w, h = texture.size[:2]
-        if w < 1 or h < 1:
+        window_texture = self.window.current_texture()
+        if min(window_texture.size[:2]) < 1:
             raise wgpu.DrawCancelled("zero-sized frame")
-        self.frame_size = (w, h)
+        self.frame_size = window_texture.size[:2]
+        scaled = self.render_scale != 1.0
+        if scaled and self.upscaler is None:
+            self.upscaler = Upscaler(self.gpu.device, self.window.format)
+        # Below scale 1 the scene (and a screenshot of it) is drawn into a smaller texture, stretched over the window.
+        texture = self.upscaler.frame(scaled_size(self.frame_size, self.render_scale)) if scaled else window_texture
+        w, h = texture.size[:2]
         camera = self.cam.camera()
         state = self.state
         draws = [self.draw_config(half) for _, half in state.shown()]
@@ -389,8 +425,14 @@ class Viewer:
             self._want_screenshot = False
             screenshot = self._save_screenshot
         self.frames.encode(texture, draws, split_x, camera, self.mode, error_range=self.error_range,
-                           screenshot=screenshot, hud=self.hud)
-        return texture
+                           screenshot=screenshot, hud=None if scaled else self.hud)
+        if scaled:
+            encoder = self.gpu.device.create_command_encoder(label="window:upscale")
+            self.upscaler.encode(encoder, window_texture)
+            if self.hud is not None:
+                self.hud.encode(encoder, window_texture.create_view())
+            self.gpu.device.queue.submit([encoder.finish()])
+        return window_texture
 
     def _update_heat_summaries(self, draws: list[DrawConfig], split_x: float | None, size: tuple[int, int], camera,
                                now: float) -> None:
@@ -429,7 +471,7 @@ class Viewer:
             s, fullscreen=self.fullscreen, vsync=self.vsync, camera_mode=self.camera_mode,
             move_speed=float(np.clip(self.move_speed, *LIMITS["move_speed"])),
             look_sensitivity=float(np.clip(self.look_sensitivity, lo, hi)),
-            show_hud=self.show_hud, show_stats=self.show_stats,
+            show_hud=self.show_hud, show_stats=self.show_stats, render_scale=self.render_choice,
             last_scene=str(self.scene.path) if self.scene.path else "", last_technique=self.state.halves["A"].technique,
         )
 

@@ -66,6 +66,24 @@ def summary_line(tag: str, summary, unit: str) -> str:
     return f"{prefix}mean {summary.mean:.3g}, p95 {summary.p95:.3g} {unit}"
 
 
+def budget_line(technique: str, params: dict) -> str | None:
+    """The pixel budget of a technique with a screen-space error budget (``max_error_px``) as the HUD shows it, with
+    the texel budget it starts from; None for a technique without one."""
+    if "max_error_px" not in {p.name for p in get_technique(technique).params}:
+        return None
+    pixels, texels = params.get("max_error_px", 0.0), params.get("max_error")
+    floor = f"{texels:g} texel" if texels is not None else "the texel budget"
+    if not pixels:
+        return f"pixel budget off (max_error_px 0): {floor} everywhere"
+    return f"pixel budget {pixels:g} px (at least {floor})"
+
+
+def _budget_tag(technique: str, params: dict) -> str:
+    """The info panel's title's note of a pixel budget (the title stays visible when the panel is collapsed)."""
+    pixels = params.get("max_error_px") if budget_line(technique, params) is not None else None
+    return f" ({pixels:g} px)" if pixels else ""
+
+
 @functools.lru_cache(maxsize=16)
 def panel_lines(renderer, technique: str, params: tuple) -> list[str]:
     """A technique's own lines on the renderer's scene (``Technique.panel_lines``; ``params``: its parameters as
@@ -246,7 +264,8 @@ class Hud:
         imgui.set_next_window_bg_alpha(PANEL_ALPHA)
         state = v.state
         a = state.halves["A"].technique
-        title = f"{state.key_for(a)} {a}" + (f" | {state.halves['B'].technique}" if state.split else "")
+        title = f"{state.key_for(a)} {a}{_budget_tag(a, v.technique_params(a))}" + (
+            f" | {state.halves['B'].technique}" if state.split else "")
         opened = imgui.begin(f"{title}###Technique", None, flags)[0]
         # Right after begin the last item is the title bar, active while the panel is dragged: it leaves the edge.
         if imgui.is_item_active() and imgui.is_mouse_dragging(imgui.MouseButton_.left):
@@ -276,6 +295,7 @@ class Hud:
             self._half(half, tag)
             imgui.separator()
         imgui.text(f"shadows (L): {state.shadows_label}   depth offset (Z): {state.depth_offset_label}")
+        imgui.text(f"render scale (U): {self.viewer.render_scale_label}")
         for i, mode in enumerate(("color", "cost", "error")):
             if i:
                 imgui.same_line()
@@ -304,6 +324,9 @@ class Hud:
         v = self.viewer
         t = get_technique(half.technique)
         self._wrapped(GREY, t.description)
+        budget = budget_line(t.name, v.technique_params(t.name))
+        if budget is not None:
+            imgui.text_colored(YELLOW, budget)
         self._params(t.name, tag)
         if t.panel_lines is not None:
             for line in panel_lines(v.renderer, t.name, tuple(sorted(v.technique_params(t.name).items()))):

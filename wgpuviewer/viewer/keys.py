@@ -71,6 +71,8 @@ CONTROLS = (
     Control("F1", "show/hide the keys", ("F1",), "toggle_help"),
     Control("V", "vsync on/off", ("v", "V"), "toggle_vsync"),
     Control("F11", "fullscreen on/off", ("F11",), "toggle_fullscreen"),
+    Control("U", "render scale: auto (on a software adapter, the scene at the fraction of the window that holds ~15 "
+            "frames per second), 1, 0.75, 0.5, 0.35, 0.25; the HUD shows it", ("u", "U"), "cycle_render_scale"),
     Control("F5", "reload shaders now (edited `wgsl/` files also reload by themselves)", ("F5",), "reload_shaders"),
     Control("Esc", "quit", ("Escape",), "quit"),
 )

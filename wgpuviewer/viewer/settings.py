@@ -21,6 +21,8 @@ from pathlib import Path
 from wgpuviewer.core import env
 from wgpuviewer.core.errors import UserError
 
+from .render_scale import CHOICES
+
 CONFIG_ENV = env.CONFIG_DIR.name
 FILE_NAME = "settings.toml"
 #: Bumped when the meaning of a key changes; a file with another version is replaced by defaults.
@@ -43,6 +45,7 @@ class Settings:
     show_stats: bool = True
     last_scene: str = ""  # path of the last scene opened ("" = the built-in default scene)
     last_technique: str = ""
+    render_scale: str = "auto"  # render_scale.CHOICES: 'auto' (a software adapter chooses) or the scene's fraction
 
 
 #: (min, max) for numbers, allowed values for strings.
@@ -53,6 +56,7 @@ LIMITS = {
     "look_sensitivity": (0.0001, 0.1),
     "zoom_sensitivity": (0.01, 0.9),
     "camera_mode": ("fly", "orbit"),
+    "render_scale": CHOICES,
 }
 
 
