@@ -29,10 +29,11 @@ def test_every_block_has_its_marker_on_its_page():
 
 @pytest.fixture
 def checkout(tmp_path) -> Path:
-    """A copy of the checkout's pages, its committed results linked in."""
+    """A copy of the checkout's pages, its committed results and its code (the results' freshness) linked in."""
     shutil.copy(ROOT / "README.md", tmp_path / "README.md")
     shutil.copytree(ROOT / "docs", tmp_path / "docs")
-    (tmp_path / "benchmarks").symlink_to(ROOT / "benchmarks")
+    for linked in ("benchmarks", "wgpuviewer", "wgsl", "maptools"):
+        (tmp_path / linked).symlink_to(ROOT / linked)
     return tmp_path
 
 

@@ -27,11 +27,18 @@ def headline_section(text: str) -> str:
     return text.split(HEADLINE_BEGIN, 1)[1].split(docs.END, 1)[0].strip()
 
 
+def headline_block(root: Path) -> str:
+    """What `wgpuviewer docs` writes there: the headline, after its run's stale label when it is not fresh."""
+    block = next(b for b in docs.BLOCKS if (b.page, b.name) == ("README.md", "headline"))
+    return docs.body(block, root).strip()
+
+
 def test_the_readme_headline_is_generated_from_the_committed_runs():
     """Regenerate it with `wgpuviewer docs`."""
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     assert text.count(HEADLINE_BEGIN) == 1
-    assert headline_section(text) == gpusuite.headline_markdown(ROOT / "benchmarks", ROOT).strip()
+    assert headline_section(text) == headline_block(ROOT)
+    assert gpusuite.headline_markdown(ROOT / "benchmarks", ROOT).strip() in headline_section(text)
 
 
 @pytest.mark.parametrize("device, slug", [("NVIDIA H200", "nvidia-h200"), ("NVIDIA H100 80GB HBM3", "nvidia-h100-80gb-hbm3"),
@@ -83,7 +90,7 @@ def bench_row(adapter: str, technique: str, params: str, angle: float, p95: floa
     return row
 
 
-def fixture_run(out_root: Path, name: str, adapter: str, software: bool, started: str) -> Path:
+def fixture_run(out_root: Path, name: str, adapter: str, software: bool, started: str, suite: str = "full") -> Path:
     """A gpu-suite run folder as the command writes it: bench's results (pom 16 within 0.5 texel, distance 256
     within 0.25), filtering finished with a report, perspective stopped at its box."""
     folder = out_root / name
@@ -101,7 +108,7 @@ def fixture_run(out_root: Path, name: str, adapter: str, software: bool, started
              {"name": "filtering", "folder": "filtering", "status": "finished", "detail": "finished in 90 s, 9 rows"},
              {"name": "perspective", "folder": "perspective", "status": "stopped",
               "detail": "stopped at its 60 s time box; 0 rows kept"}]
-    manifest = {"command": "./dev gpu-suite", "suite": "full", "adapter": adapter, "software": software,
+    manifest = {"command": "./dev gpu-suite", "suite": suite, "adapter": adapter, "software": software,
                 "started": started, "seconds": 470.0, "budget_s": 480.0, "parts": parts}
     (folder / gpusuite.MANIFEST).write_text(json.dumps(manifest))
     return folder
@@ -137,6 +144,20 @@ def test_without_a_gpu_run_the_headline_names_the_software_adapter(tmp_path):
     assert "SMs" not in text
 
 
+def test_the_headline_shows_the_widest_run_before_a_newer_smaller_one(tmp_path):
+    runs = tmp_path / "benchmarks"
+    fixture_run(runs, "llvmpipe-reduced", LLVMPIPE, True, "2026-12-01T10:00:00Z", suite="reduced")
+    fixture_run(runs, "llvmpipe-smoke", LLVMPIPE, True, "2026-12-02T10:00:00Z", suite="smoke")
+    assert gpusuite.headline_run(gpusuite.load_runs(runs)).folder.name == "llvmpipe-reduced"
+    manifest = runs / "llvmpipe-reduced" / gpusuite.MANIFEST
+    stopped = json.loads(manifest.read_text())
+    stopped["parts"][0]["status"] = "stopped"
+    manifest.write_text(json.dumps(stopped))
+    assert gpusuite.headline_run(gpusuite.load_runs(runs)).folder.name == "llvmpipe-smoke"  # a finished bench first
+    fixture_run(runs, "nvidia-h200-smoke", H200, False, "2026-11-01T10:00:00Z", suite="smoke")
+    assert gpusuite.headline_run(gpusuite.load_runs(runs)).folder.name == "nvidia-h200-smoke"  # a GPU first
+
+
 def test_the_docs_command_rewrites_only_the_headline_from_a_new_run(tmp_path, capsys):
     runs = tmp_path / "benchmarks"
     fixture_run(runs, "nvidia-h200", H200, False, "2026-12-01T10:00:00Z")
@@ -147,10 +168,11 @@ def test_the_docs_command_rewrites_only_the_headline_from_a_new_run(tmp_path, ca
     assert "README.md: block 'headline' differs" in capsys.readouterr().out
     assert readme.read_text(encoding="utf-8") == before
     assert docs.run(tmp_path, check=False) == 0
-    assert capsys.readouterr().out.splitlines() == ["README.md: block 'headline' regenerated from the newest "
+    assert capsys.readouterr().out.splitlines() == ["README.md: block 'headline' regenerated from the widest "
                                                     "./dev gpu-suite run under benchmarks/"]
     after = readme.read_text(encoding="utf-8")
-    assert headline_section(after) == gpusuite.headline_markdown(runs, tmp_path)
+    assert headline_section(after).endswith(gpusuite.headline_markdown(runs, tmp_path))
+    assert "`benchmarks/nvidia-h200/bench/` has no stamp.json" in headline_section(after)  # the fixture has none
     assert after.split(HEADLINE_BEGIN)[0] == before.split(HEADLINE_BEGIN)[0]
     assert after.split(HEADLINE_BEGIN)[1].split(docs.END, 1)[1] == before.split(HEADLINE_BEGIN)[1].split(docs.END, 1)[1]
     assert docs.run(tmp_path, check=True) == 0
@@ -217,6 +239,8 @@ def test_the_headline_of_a_tiny_run_names_the_software_adapter(tiny_run, adapter
     _, folder, root = tiny_run
     assert not (root / "README.md").exists()  # a run writes no page
     shutil.copy(ROOT / "README.md", root / "README.md")
+    for code in ("wgpuviewer", "wgsl", "maptools"):  # the code the run measured: it is fresh, no stale label
+        (root / code).symlink_to(ROOT / code)
     _, new, changed = docs.regenerate(root, root / "README.md")
     assert changed == ["headline"]
     section = headline_section(new)

@@ -1,10 +1,16 @@
 """``wgpuviewer docs [--check]``: every generated block of README.md and docs/*.md written again from its one source,
-by this explicit command (no measurement writes the checkout's pages).
+by this explicit command (no measurement writes the checkout's pages); and ``wgpuviewer results [--check]``: every
+results folder under ``benchmarks/`` as fresh or stale (``lab.results``), ``--check`` exiting 1 naming the folders
+whose blocks differ from what their results and freshness make (a change to measured code fails it until the docs
+say the folder is stale, or it is measured again; it measures nothing).
 
 A block is the text between a ``<!-- generated: NAME -->`` line and the next ``<!-- end generated -->`` line; each
 (page, NAME) has one source in ``BLOCKS``: a registry's table (techniques, filters, map kinds, viewer keys) or a
-committed results folder (the README's headline from the newest ``./dev gpu-suite`` run under ``benchmarks/``; each
-study folder's ``docs.py`` ``BLOCKS``, e.g. docs/filtering.md's numbers from ``benchmarks/filtering_lavapipe/``).
+committed results folder (the README's headline from the widest ``./dev gpu-suite`` run under ``benchmarks/``;
+bench's runs, ``lab.bench.docs``; each study folder's ``docs.py`` ``BLOCKS``, e.g. docs/filtering.md's numbers
+from ``benchmarks/filtering_lavapipe/``).
+A block made from a results folder whose code fingerprint is not today's starts with the folder's stale label
+(``results.stale_note``: measured on the code of DATE; stale since WHAT changed), added here for every block alike.
 A marker with no source, or a source whose marker is missing from its page, is an error: a block is never silently
 left alone. Pages are written atomically and only when a block changed; ``--check`` writes nothing and exits 1
 naming every block that differs.
@@ -24,6 +30,8 @@ from pathlib import Path
 
 from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.io import write_bytes
+from wgpuviewer.lab import results
+from wgpuviewer.lab.harness import stamp
 from wgpuviewer.lab.harness.blocks import Block
 from wgpuviewer.lab.harness.study import STUDIES_PACKAGE
 
@@ -63,8 +71,16 @@ def _headline(root: Path) -> str:
     return headline_markdown(root / "benchmarks", root)
 
 
+def _headline_folder(root: Path) -> str | None:
+    from wgpuviewer.lab.gpusuite import headline_run, load_runs
+
+    run = headline_run(load_runs(root / "benchmarks"))
+    return None if run is None else run.results.parent.relative_to(root).as_posix()
+
+
 OWN_BLOCKS = (
-    Block("README.md", "headline", "the newest ./dev gpu-suite run under benchmarks/", _headline),
+    Block("README.md", "headline", "the widest ./dev gpu-suite run under benchmarks/", _headline,
+          results=_headline_folder),
     Block("README.md", "techniques", "the technique registry", _techniques),
     Block("README.md", "filters", "the filter registry", _filters),
     Block("README.md", "map kinds", "the map-kind registry", _map_kinds),
@@ -81,7 +97,14 @@ def study_blocks(package: str = STUDIES_PACKAGE) -> tuple[Block, ...]:
     return tuple(found)
 
 
-BLOCKS = OWN_BLOCKS + study_blocks()
+def bench_blocks() -> tuple[Block, ...]:
+    """bench's blocks (``lab.bench.docs``: its committed runs' headlines and fetch tables)."""
+    from wgpuviewer.lab.bench.docs import BLOCKS as BENCH
+
+    return BENCH
+
+
+BLOCKS = OWN_BLOCKS + bench_blocks() + study_blocks()
 
 
 def pages(root: Path) -> list[Path]:
@@ -97,6 +120,17 @@ def replace_block(text: str, name: str, body: str, page: str = "the page") -> st
     if end is None:
         raise UserError(f"{page}: needs one {begin!r} line followed by an {END!r} line; add them where the block goes")
     return f"{text[:found[0].start()]}{begin}\n{body}\n{END}{text[end.end():]}"
+
+
+def body(block: Block, root: Path) -> str:
+    """The block's text: its source's, after its folder's stale label when the folder is not fresh; while the folder
+    holds no results (no CSV: a run in progress, or none yet), a line saying so."""
+    folder = block.folder(root)
+    if folder is not None and not any((root / folder).glob("*.csv")):
+        return f"`{folder}/` holds no results yet: run its command, then `wgpuviewer docs`."
+    text = block.body(root)
+    note = results.stale_note(root, folder) if folder is not None else None
+    return text if note is None else f"{note}\n\n{text.lstrip(chr(10))}"
 
 
 def regenerate(root: Path, page: Path) -> tuple[str, str, list[str]]:
@@ -116,7 +150,7 @@ def regenerate(root: Path, page: Path) -> tuple[str, str, list[str]]:
     new, changed = text, []
     for name, block in known.items():
         old = new
-        new = replace_block(new, name, block.body(root), relative)
+        new = replace_block(new, name, body(block, root), relative)
         if new != old:
             changed.append(name)
     return text, new, changed
@@ -165,8 +199,60 @@ class Docs:
 COMMAND = Docs()
 
 
+def check_results(root: Path) -> list[str]:
+    """The folders whose generated blocks differ from what their results and freshness make, with the blocks."""
+    bad = []
+    for page in pages(root):
+        relative = page.relative_to(root).as_posix()
+        for name in regenerate(root, page)[2]:
+            block = next(b for b in BLOCKS if b.page == relative and b.name == name)
+            folder = block.folder(root)
+            if folder is not None:
+                bad.append(f"{folder}: {results.freshness(root, folder).status()}; its block {name!r} on {relative} "
+                           "differs from what it makes")
+    return bad
+
+
+class Results:
+    name = "results"
+    help = "list every results folder under benchmarks/ as fresh or stale (--check: exit 1 on a stale generated block)"
+
+    def add_arguments(self, parser) -> None:
+        parser.add_argument("--check", action="store_true",
+                            help="exit 1 naming each folder whose generated blocks differ from what its results and "
+                            "freshness make (run `wgpuviewer docs`, or measure it again)")
+        parser.add_argument("--stamp-from-git", nargs="+", metavar="FOLDER",
+                            help="write FOLDER/stamp.json from git for folders measured before stamps existed")
+        parser.add_argument("--root", default=str(CHECKOUT), help="the checkout (default: this one)")
+
+    def command(self, args) -> int:
+        root = Path(args.root)
+        if not (root / results.BENCHMARKS).is_dir():
+            raise UserError(f"--root {root}: no {results.BENCHMARKS}/ there; give a checkout of wgpuviewer")
+        for folder in args.stamp_from_git or ():
+            if not (root / folder).is_dir():
+                raise UserError(f"--stamp-from-git {folder}: no such folder under {root}")
+            stamp.write(root / folder, results.stamp_from_git(root, folder))
+        if args.check:
+            bad = check_results(root)
+            for line in bad:
+                print(line)
+            if bad:
+                print("run `wgpuviewer docs` (the blocks then say they are stale), or measure again", file=sys.stderr)
+                return 1
+            print("every block made from results is what its results and their freshness make")
+            return 0
+        print("\n".join(results.listing(root)))
+        return 0
+
+
+RESULTS = Results()
+
+
 def register(subparsers) -> None:
-    """``wgpuviewer docs`` on the command line's ``subparsers``."""
-    parser = subparsers.add_parser(COMMAND.name, help=COMMAND.help)
-    COMMAND.add_arguments(parser)
-    parser.set_defaults(func=COMMAND.command)
+    """``wgpuviewer docs`` and ``wgpuviewer results`` (``lab.results``, the freshness of what the blocks are made
+    from) on the command line's ``subparsers``."""
+    for command in (COMMAND, RESULTS):
+        parser = subparsers.add_parser(command.name, help=command.help)
+        command.add_arguments(parser)
+        parser.set_defaults(func=command.command)

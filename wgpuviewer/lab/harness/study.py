@@ -3,9 +3,11 @@
 with the options every measuring command shares (the CLI puts the command line, ``core.commands.command_line``, on
 ``args.command_line`` for the report's header), and ``run_study``, the one order every measuring command runs in:
 every option value checked, then the output folder checked and created and the stale temps of a killed earlier
-run swept from it, then the measurement (the GPU starts only there). ``StudyCommand`` is the common form of a
-study's ``STUDY`` (its name, help and suite help; its own options; ``run`` calling the folder's ``run.run``), and
-``numbers_within`` checks a comma-separated option of numbers against a range.
+run swept from it, then the measurement (the GPU starts only there), then the folder's ``stamp.json``
+(``stamp``: the command, the adapter, the date and the fingerprint of the code, hashed before the measurement).
+``StudyCommand`` is the common form of a study's ``STUDY`` (its name, help and suite help; its own options; ``run``
+calling the folder's ``run.run``), and ``numbers_within`` checks a comma-separated option of numbers against a
+range.
 
 A study's ``__init__`` stays light (no GPU, no heavy imports): the command line imports every study to build
 its parser; ``options`` and ``run`` import the measuring code when the command runs.
@@ -16,6 +18,7 @@ from __future__ import annotations
 import argparse
 import functools
 import importlib
+import inspect
 import pkgutil
 from pathlib import Path
 from typing import Protocol, runtime_checkable
@@ -23,6 +26,8 @@ from typing import Protocol, runtime_checkable
 from wgpuviewer.core.commands import add_backend_option
 from wgpuviewer.core.io import output_dir, remove_abandoned_temps
 
+from . import stamp
+from .header import Clock
 from .suite import NAMES
 
 STUDIES_PACKAGE = "wgpuviewer.lab.studies"
@@ -74,7 +79,13 @@ def run_study(study: Study, args: argparse.Namespace) -> int:
     options = study.options(args)
     out = output_dir(args.out, "--out")
     remove_abandoned_temps(out)
-    return study.run(options, out)
+    package = stamp.package_of(inspect.getfile(type(study)))
+    before, clock = stamp.everything(stamp.Files(stamp.CHECKOUT), package), Clock()  # the code this run loaded
+    code = study.run(options, out)
+    if code == 0:  # a failed run stamps nothing: its folder holds no complete results
+        stamp.write(out, stamp.stamp(out, getattr(args, "command_line", "") or "", clock.started, clock.seconds,
+                                     before, package))
+    return code
 
 
 def add_measurement_options(parser, out_help: str, suite_help: str) -> None:
