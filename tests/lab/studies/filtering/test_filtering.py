@@ -32,12 +32,12 @@ from wgpuviewer.lab.studies.filtering.views import (
     albedo_image,
     depth_map,
     make_view,
+    relief_height,
 )
 from wgpuviewer.relief.filter_probe import explicit_gradient_probe, explicit_gradient_support
 from wgpuviewer.relief.filters import DERIVATIVE_LIMIT, FILTERS, FLAGS
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels
 from wgpuviewer.relief.renderer import Renderer
-from wgpuviewer.textures import builtin_height
 
 SIZE = (32, 24)
 GOLDEN_SCENE = Path(__file__).resolve().parents[3] / "relief" / "golden" / "scene.toml"  # small textures
@@ -159,14 +159,22 @@ def test_gaussian_average_is_a_normalised_symmetric_kernel():
 
 
 def test_masked_albedo_is_a_fine_checker_exactly_on_the_low_parts():
-    for relief in ("bricks", "step"):
+    for relief in ("bricks", "step", "brick"):
         image = albedo_image("masked", relief=relief)
-        low = builtin_height(relief, (TEXTURE_SIZE, TEXTURE_SIZE)) < MASK_LEVEL
+        low = relief_height(relief) < MASK_LEVEL
         assert 0.05 < low.mean() < 0.95
         grey = image[..., 0]
         # low parts alternate dark and bright from texel to texel; high parts are one colour
         assert np.abs(np.diff(grey, axis=1))[(low[:, 1:] & low[:, :-1])].min() > 0.5
         assert np.ptp(image[~low].reshape(-1, 3), axis=0).max() == 0.0
+
+
+def test_photographic_relief_is_the_photograph_as_depth_and_own_albedo(folder):
+    view = make_view(Case("brick", "own", 80.0, 2.0), (16, 12), folder)
+    height = relief_height("brick")
+    assert height.shape == (TEXTURE_SIZE, TEXTURE_SIZE) and np.ptp(height) > 0.3
+    np.testing.assert_allclose(depth_map(view), 1.0 - height, atol=1e-6)  # brighter = higher = less deep
+    assert view.scene.materials["relief"].albedo == view.scene.materials["relief"].height
 
 
 def test_shifted_view_slides_the_picture_by_the_asked_texels(folder):
@@ -365,8 +373,13 @@ DOCS = Path(__file__).resolve().parents[4] / "docs" / "filtering.md"
 def test_docs_quote_the_committed_run():
     """docs/filtering.md's generated block is the one its committed results.csv gives, to the character."""
     text = DOCS.read_text()
-    start, end = text.index(DOCS_BEGIN), text.index(DOCS_END) + len(DOCS_END)
-    assert text[start:end] == docs_block_of(COMMITTED)
+    start = text.index(DOCS_BEGIN)
+    end = text.index(DOCS_END, start) + len(DOCS_END)
+    from wgpuviewer.lab import docs
+    from wgpuviewer.lab.studies.filtering.docs import BLOCKS
+
+    assert docs_block_of(COMMITTED).split("\n", 1)[1].rstrip(DOCS_END) in text[start:end]  # after any stamp note
+    assert text[start:end] == f"{DOCS_BEGIN}\n{docs.body(BLOCKS[0], COMMITTED.parents[1])}\n{DOCS_END}"
 
 
 def test_committed_report_is_its_results_csv(tmp_path):

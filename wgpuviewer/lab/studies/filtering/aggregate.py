@@ -65,3 +65,15 @@ def against(rows: list[dict], config: Config) -> dict[str, list[float]]:
 
 def _fmt(v: float, spec: str = "+.2f") -> str:
     return "–" if not math.isfinite(v) else format(v, spec)
+
+
+FOLLOWS = ("own", "masked")  # the albedos that follow the relief
+
+
+def beyond_uncertainty(group: list[dict], rows: list[dict], other: str) -> tuple[int, int]:
+    """How many rows of ``group`` beat, and lose to, the row labelled ``other`` of the same case in ``rows`` by more
+    than both rows' reference uncertainty."""
+    by_case = {r["case"]: r for r in rows if r["label"] == other}
+    pairs = [(r, by_case[r["case"]]) for r in group if r["case"] in by_case]
+    margins = [(a["psnr"] - b["psnr"], a["psnr_uncertainty"] + b["psnr_uncertainty"]) for a, b in pairs]
+    return sum(d > m for d, m in margins), sum(-d > m for d, m in margins)

@@ -21,7 +21,7 @@ from wgpuviewer.core.io import write_bytes
 from wgpuviewer.lab.harness.header import Header
 from wgpuviewer.relief.filters import get_filter
 
-from .aggregate import _fmt, _geomean, _mean, against, by_config, differences, label, ranked
+from .aggregate import FOLLOWS, _fmt, _geomean, _mean, against, beyond_uncertainty, by_config, differences, label, ranked
 from .pictures import write_crops, write_distributions, write_pareto
 from .suites import BASELINE, BILINEAR, EXACT, RUN_FILE, TABLE, Suite
 from .views import ALBEDOS, HEIGHT_SCALE, RELIEFS, TECHNIQUE, Case
@@ -29,7 +29,6 @@ from .views import ALBEDOS, HEIGHT_SCALE, RELIEFS, TECHNIQUE, Case
 __all__ = ["TABLE", "TITLE", "rereport", "write", "wanted_for_pictures", "recommendation"]
 
 #: Albedo classes of the recommendation: does the albedo follow the relief's height?
-FOLLOWS = ("own", "masked")
 NEAR_BEST_DB = 0.5  # "cheapest within this of the best"
 TRACER_NAMES = {"maxmip": "exact (maxmip)", "pom32": "POM, 32 layers"}
 
@@ -194,15 +193,6 @@ def visibility(rows: list[dict]) -> list[str]:
     return lines
 
 
-def beyond_uncertainty(group: list[dict], rows: list[dict], other: str) -> tuple[int, int]:
-    """How many rows of ``group`` beat, and lose to, the row labelled ``other`` of the same case in ``rows`` by more
-    than both rows' reference uncertainty."""
-    by_case = {r["case"]: r for r in rows if r["label"] == other}
-    pairs = [(r, by_case[r["case"]]) for r in group if r["case"] in by_case]
-    margins = [(a["psnr"] - b["psnr"], a["psnr_uncertainty"] + b["psnr_uncertainty"]) for a, b in pairs]
-    return sum(d > m for d, m in margins), sum(-d > m for d, m in margins)
-
-
 def weighting(rows: list[dict]) -> list[str]:
     """Inherit against drop, per group and configuration."""
     valid = [r for r in ranked(rows) if r["occluding"]]
@@ -322,7 +312,8 @@ def markdown(rows: list[dict], record: dict, pictures: list[str], pareto: str | 
                   + " ".join(record.get("void_notes", [])), ""]
     lines += ["## Recommendation", "", *recommendation(rows), "", "Plain EWA by derivative source (exact tracer):",
               "", *derivative_sources(rows), "", "## Visibility (the paper's question)", "", *visibility(rows), "",
-              "The substitute inheriting the hidden texel's weight, against dropping it:", "", *weighting(rows), ""]
+              "The substitute inheriting the hidden texel's weight, against dropping it:", "", *weighting(rows), "",
+              "## Visibility by relief, case by case", "", *by_relief(rows), ""]
     if pareto:
         lines += [f"![error against time]({pareto})", ""]
     if distributions:
@@ -339,6 +330,12 @@ def markdown(rows: list[dict], record: dict, pictures: list[str], pareto: str | 
     lines += ["", "Reliefs: " + "; ".join(f"`{k}` {v}" for k, v in RELIEFS.items()) + ".",
               "Albedos: " + "; ".join(f"`{k}` {v}" for k, v in ALBEDOS.items()) + ".", ""]
     return "\n".join(lines)
+
+
+def by_relief(rows: list[dict]) -> list[str]:
+    from .byrelief import section  # it builds on this module's groups and counts
+
+    return section(rows)
 
 
 def per_case(rows: list[dict], record: dict) -> list[str]:

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from wgpuviewer.core.errors import UserError
 from wgpuviewer.core.gpu import get_gpu
 from wgpuviewer.core.io import write_bytes
 from wgpuviewer.lab.harness.header import Clock
@@ -57,7 +58,10 @@ def psnr(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def ssim(a: np.ndarray, b: np.ndarray) -> float:
-    from skimage.metrics import structural_similarity
+    try:
+        from skimage.metrics import structural_similarity
+    except ImportError:
+        raise UserError("the filtering study's SSIM needs scikit-image: pip install 'wgpuviewer[bench]'") from None
 
     return float(structural_similarity(a, b, channel_axis=2, data_range=1.0, win_size=7))
 

@@ -34,8 +34,12 @@ TECHNIQUE = "maxmip"  # exact first hits (to float32) for the filters and the re
 #: Reliefs: builtin height maps; flat0 is a flat relief (every ray reaches the floor, nothing is hidden).
 RELIEFS = {"bricks": "bricks (occlusion at the mortar)", "step": "one 0-to-1 step per tile (occlusion behind it)",
            "wall": "a one-texel wall per tile", "flat0": "flat (depth 1: displaced, nothing hidden)",
-           "bumps": "smooth bumps (occlusion behind their crests at grazing views; the tuning cases' relief)"}
-OCCLUDING = ("bricks", "step", "wall", "bumps")
+           "bumps": "smooth bumps (occlusion behind their crests at grazing views; the tuning cases' relief)",
+           "brick": "scikit-image's brick photograph, 256x256 (brighter = higher; its own albedo is the photograph)"}
+OCCLUDING = ("bricks", "step", "wall", "bumps", "brick")
+#: Photographic reliefs: scikit-image's bundled grey textures, area-downscaled to TEXTURE_SIZE (a PNG per relief,
+#: written into the study's folder; the height and the "own" albedo alike).
+PHOTO_RELIEFS = ("brick",)
 #: High-frequency albedos (sRGB PNGs written into the study's folder).
 #: "own": the relief builtin's own albedo, whose colour follows the height (mortar vs brick, low vs high side of a
 #: step): there the hidden texels differ from the visible ones, the case the filtering paper is about.
@@ -70,7 +74,7 @@ def albedo_image(name: str, size: int = TEXTURE_SIZE, relief: str = "") -> np.nd
     if name == "masked":
         # High frequencies exactly where the relief hides texels at grazing views: the hidden texels differ from
         # the visible ones in detail as well as in colour, unlike "own" (smooth) and the relief-blind albedos.
-        low = textures.builtin_height(relief, (size, size)) < MASK_LEVEL
+        low = relief_height(relief, size) < MASK_LEVEL
         fine = np.where((i + j) % 2, 0.9, 0.08)[..., None] * np.array([1.0, 0.95, 0.85])
         return np.where(low[..., None], fine, np.array([0.62, 0.25, 0.18]))
     if name == "checker":
@@ -89,6 +93,32 @@ def albedo_image(name: str, size: int = TEXTURE_SIZE, relief: str = "") -> np.nd
         image = np.asarray(skimage.data.astronaut(), np.float32) / 255.0
         return np.clip(cv2.resize(image, (size, size), interpolation=cv2.INTER_AREA), 0.0, 1.0)
     raise UserError(f"albedo {name!r}: unknown; expected one of {', '.join(ALBEDOS)}")
+
+
+def relief_height(name: str, size: int = TEXTURE_SIZE) -> np.ndarray:
+    """(size, size) float32 height in [0, 1] of a builtin relief or a photographic one (brighter = higher)."""
+    if name not in PHOTO_RELIEFS:
+        return textures.builtin_height(name, (size, size))
+    import cv2
+    import skimage.data
+
+    grey = cv2.resize(np.asarray(getattr(skimage.data, name)(), np.uint8), (size, size), interpolation=cv2.INTER_AREA)
+    return grey.astype(np.float32) / 255.0  # the 8-bit values the PNG holds
+
+
+def write_relief(name: str, folder: Path) -> str:
+    """The scene TOML value of the relief's height (and "own" albedo): a builtin table, or the photographic relief
+    written once as an 8-bit grey PNG in ``folder``."""
+    if name not in PHOTO_RELIEFS:
+        return f'{{ builtin = "{name}", size = [{TEXTURE_SIZE}, {TEXTURE_SIZE}] }}'
+    import cv2
+
+    path = Path(folder) / f"relief_{name}.png"
+    if not path.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if not cv2.imwrite(str(path), np.rint(relief_height(name) * 255).astype(np.uint8)):
+            raise UserError(f"{path}: could not write the relief texture")
+    return _toml_path(path)
 
 
 def write_albedo(name: str, folder: Path, relief: str = "") -> Path:
@@ -179,12 +209,10 @@ def make_view(case: Case, size: tuple[int, int], folder: Path) -> View:
     extent = float(extent)
     uv_scale = float(extent * uv_per_world)
     view.plane_size, view.uv_scale = (extent, extent), (uv_scale, uv_scale)
-    if case.albedo == "own":
-        albedo = f'{{ builtin = "{case.relief}", size = [{TEXTURE_SIZE}, {TEXTURE_SIZE}] }}'
-    else:
-        albedo = _toml_path(write_albedo(case.albedo, folder, case.relief))
+    relief = write_relief(case.relief, folder)
+    albedo = relief if case.albedo == "own" else _toml_path(write_albedo(case.albedo, folder, case.relief))
     text = SCENE.format(name=case.name, eye=_vec(eye), up=_vec(camera.up), fov=fov, albedo=albedo,
-                        relief=case.relief, texels=TEXTURE_SIZE, scale=HEIGHT_SCALE, uv_scale=uv_scale, size=extent,
+                        relief=relief, scale=HEIGHT_SCALE, uv_scale=uv_scale, size=extent,
                         azimuth=AZIMUTH, technique=TECHNIQUE)
     view.scene = parse_scene(text)
     return view
@@ -222,7 +250,7 @@ near = 0.01
 far = 100.0
 [materials.relief]
 albedo = {albedo}
-height = {{ builtin = "{relief}", size = [{texels}, {texels}] }}
+height = {relief}
 height_scale = {scale!r}
 uv_scale = [{uv_scale!r}, {uv_scale!r}]
 [[objects]]

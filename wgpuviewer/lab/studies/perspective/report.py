@@ -41,6 +41,7 @@ from .tables import (
     tieback_table,
     tile_table,
 )
+from .threads_report import section as threads_section
 
 
 def every_row(_row) -> bool:
@@ -465,6 +466,10 @@ def report_text(rows: list[dict], relief: list[dict], meta: dict, plotted: bool)
         "numpy form (whole-array passes; Python loops for the Kahan, two-float and adaptive forms).",
         "",
         *gpu_table(rows, meta["software"]),
+        "",
+        "## The parallel forms on real threads",
+        "",
+        *threads_section(meta.get("threads", [])),
         "",
         "## Relief tie-back (p99 hit-uv error, texels; the entry uv rounded to float32 at that magnitude, the search "
         "on its fraction)",

@@ -38,7 +38,7 @@ from wgpuviewer.lab.harness import suite as harness_suite
 from wgpuviewer.lab.harness.header import Clock
 from wgpuviewer.lab.harness.table import Column, Table, columns
 
-from . import tieback
+from . import threads_report, tieback
 from .geometry import Quad, Reference, Setup, Spans, at_footprint, build, reference, tiles_of
 from .methods import METHODS, Result, evaluate, ops_per_texel
 
@@ -475,6 +475,8 @@ def run(suite_name: str, out: Path, backend: str | None = None, progress: bool =
         bar.set_postfix_str(f"speed {suite.tile_timing}-pixel tiles")
         study.rows += study.tile_speed(suite.speed_frames[0], suite.tile_timing)
         bar.update()
+        first = suite.speed_frames[0]  # timed on threads after the single-threaded timings, before the heat map
+        threads = threads_report.measure_suite(suite, build(configured(Setup(first[0], rows=first[1], tilt=SWEEP_TILT))))
         bar.set_postfix_str("heat map")
         heat = study.heatmap()
         bar.update()
@@ -484,9 +486,10 @@ def run(suite_name: str, out: Path, backend: str | None = None, progress: bool =
     TABLE.write(out / "results.csv", study.rows)
     ALONG_TABLE.write(out / "along_span.csv", study.along)
     TIEBACK_TABLE.write(out / "tieback.csv", relief)
+    threads_report.THREADS_TABLE.write(out / threads_report.THREADS_FILE, threads)
     meta = {
         "header": clock.header(TITLE, command, study.gpu.summary, suite.name),
-        "suite": suite, "software": study.gpu.software, "cpu": cpu_model(),
+        "suite": suite, "software": study.gpu.software, "threads": threads, "cpu": cpu_model(),
         "python": platform.python_version(), "numpy": np.__version__, "numba": numba_module().__version__,
         "platform": platform.platform(),
     }
