@@ -11,7 +11,7 @@ from maptools.cache import cached_generate
 from maptools.kinds.distance_refined.slot import REFINED_BANDS, REFINED_MAX_ANGLE, REFINED_SECTORS
 from maptools.volume.slot import DISTANCE_SLICES, uploaded_volume
 from wgpuviewer.lab.bench.run import REAL_MAPS
-from wgpuviewer.lab.studies.refined_distance import donnelly, formats, pits, reliefs
+from wgpuviewer.lab.studies.refined_distance import bounded, donnelly, formats, pits, reliefs
 from wgpuviewer.lab.studies.refined_distance.baseline import plain_before
 from wgpuviewer.lab.studies.refined_distance.report import ratios
 from wgpuviewer.lab.studies.refined_distance.run import SUITES, run
@@ -85,6 +85,15 @@ def test_smoke_suite(tmp_path, gpu):
     assert all(r["fetches_mean"] >= 1 for r in res.pits)
     assert "### Deeper and wider holes" in text and (tmp_path / "pits.csv").exists()
     assert all(f"| {p.name} |" in text for p in pits.PLATES)
+    # the bound: every variant at every angle on the bounded maps; the worked example with its numbers and picture
+    assert {(r["heightmap"], r["angle"], r["variant"]) for r in res.bounded} == {
+        (m, a, v) for m in suite.exact_maps for a in suite.exact_angles
+        for v in (*bounded.PRODUCT_VARIANTS, bounded.EXACT_SINGLE, bounded.EXACT_BINNED)}
+    assert all(r["fetches_mean"] >= 1 and 0 <= r["passed"] <= 1 for r in res.bounded)
+    assert {m["variant"] for m in res.bounded_maps} == {bounded.EXACT_SINGLE, bounded.EXACT_BINNED}
+    assert "## The paper's worked example" in text and "## The refined map bounded: exact visibility" in text
+    assert (tmp_path / "worked_example.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "bounded.csv").exists() and (tmp_path / "example.csv").exists()
 
 
 def test_cli_rejects_bad_options(tmp_path, capsys):
@@ -135,6 +144,9 @@ def test_the_options_take_grazing_angles_and_the_generated_maps():
     args.command_line = "wgpuviewer refined-distance"
     options = STUDY.options(args)
     assert options["angles"] == [85.0, 87.0, 89.0] and options["heightmaps"] == ["plate", "grille", "bricks"]
+    bound = parser.parse_args(["--out", "x", "--only", "bounded"])
+    bound.command_line = "wgpuviewer refined-distance --only bounded"
+    assert options["only"] == "" and STUDY.options(bound)["only"] == "bounded"
 
 
 def _components(mask: np.ndarray) -> list[np.ndarray]:

@@ -4,14 +4,14 @@ condition, grazing views, Donnelly's regime, the map formats) and its plot (``ra
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from maptools.kinds.distance_refined.slot import REFINED_MAX_ANGLE
 from wgpuviewer.lab.harness.header import Header
 from wgpuviewer.lab.harness.plots import MISSING, pyplot, save_png
 
-from . import formats, pits
+from . import bounded, example, formats, pits
 from .variants import CONDITION_PAIRS, OTHER_STORAGES, PLAIN, PRODUCT, VARIANTS
 
 #: Files of a run (a stale one from an earlier layout is removed by the lead, not here).
@@ -25,6 +25,11 @@ class Results:
     formats: list[dict]
     costs: list[dict]
     pits: list[dict]
+    bounded: list[dict] = field(default_factory=list)  # bounded.TABLE's rows
+    bounded_maps: list[dict] = field(default_factory=list)  # bounded.MAPS_TABLE's
+    example: example.Example | None = None  # the paper's worked example
+    cuts: dict = field(default_factory=dict)  # sectors -> the conservative cut at C (degrees)
+    example_plotted: bool = False
 
 
 def _twins(rows: list[dict]) -> list[dict]:
@@ -104,15 +109,22 @@ def _change(by: dict, variant: str, base: str) -> str:
     return f"{_pct(a['fetches_mean'], b['fetches_mean'])} / {_pct(a['fetches_simd'], b['fetches_simd'])}"
 
 
-def report(res: Results, header: Header, plotted: bool) -> str:
-    """Markdown: the paper's condition (on vs off), per height map every variant's fetches by angle with the
-    changes, grazing views, Donnelly's regime, the map formats."""
-    lines = [*header.lines(), "",
-             "Every fetch to the final hit (volume fetches and exact-cell gathers), the same tracer (the numpy twin of "
-             "`distance.wgsl`) for every map; the GPU renderer beside it where a technique binds the map. Changes: "
-             "mean / SIMD-tile. " + (f"Picture (ratios to the `distance` map): [{PLOT}]({PLOT})." if plotted
-                                    else MISSING), ""]
-    lines += _condition_section(res.rows)
+def report(res: Results, header: Header, plotted: bool | None) -> str:
+    """Markdown: the worked example and the bound, the paper's condition (on vs off), per height map every variant's
+    fetches by angle with the changes, grazing views, Donnelly's regime, the map formats. ``plotted`` None: a run of
+    the bound alone (no variants' picture)."""
+    lines = [*header.lines(), ""]
+    if plotted is not None:
+        lines += ["Every fetch to the final hit (volume fetches and exact-cell gathers), the same tracer (the numpy twin "
+                  "of `distance.wgsl`) for every map; the GPU renderer beside it where a technique binds the map. "
+                  "Changes: mean / SIMD-tile. " + (f"Picture (ratios to the `distance` map): [{PLOT}]({PLOT})."
+                                                  if plotted else MISSING), ""]
+    if res.example is not None:
+        lines += example.section(res.example, res.cuts, f"Picture: [{example.PLOT}]({example.PLOT})."
+                                 if res.example_plotted else MISSING)
+    lines += bounded.section(res.bounded, res.bounded_maps)
+    if res.rows:
+        lines += _condition_section(res.rows)
     lines += pits.section(res.pits)
     lines += _variant_sections(res.rows)
     lines += _grazing_section(res.rows)

@@ -24,7 +24,7 @@ from wgpuviewer.lab.harness.table import Column, Table
 from wgpuviewer.relief.accuracy import simd_tile_cost
 from wgpuviewer.relief.maps import depth_range
 
-from . import donnelly, formats, pits, reliefs
+from . import bounded, donnelly, example, formats, pits, reliefs
 from .baseline import plain_before
 from .report import PLOT, Results, plot, report
 from .tracer import trace
@@ -53,15 +53,24 @@ class Suite(harness_suite.Suite):
     pit_angles: tuple[float, ...]
     pit_rays: int
     pit_budget: int
+    #: the refined map bounded (bounded.py), on its own maps whatever --heightmaps says: the maps, texels per side,
+    #: angles, random rays per texel and bin per batch, batches, fresh rays of the check (over all bins)
+    exact_maps: tuple[str, ...]
+    exact_size: int
+    exact_angles: tuple[float, ...]
+    exact_rays: int
+    exact_batches: int
+    exact_checks: int
 
 
 SUITES = harness_suite.suites(
     Suite("smoke", ("bricks", "plate"), (45.0, 87.0), (32, 16), 32, 256, (60.0,), (8, 64), (32, 64), 30.0,
-          ("plate",), (45.0, 89.0), 2, 32, (15.0,), 400, 8),
+          ("plate",), (45.0, 89.0), 2, 32, (15.0,), 400, 8, ("plate",), 16, (60.0,), 4, 2, 256),
     Suite("full", ("brick", "grass", "gravel", "bricks", "bumps", "ridges", "wall", *reliefs.NAMES),
           (0.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 87.0, 89.0), (256, 144), 256, 4096, (45.0, 60.0, 75.0, 85.0),
           (8, 16, 32, 64), (256, 512, 1024), 60.0, ("bricks", "plate"), (45.0, 60.0, 75.0, 85.0, 89.0), 5,
-          128, (0.0, 15.0, 30.0, 45.0, 60.0), 20000, 8),
+          128, (0.0, 15.0, 30.0, 45.0, 60.0), 20000, 8, tuple(bounded.CLASSES), 64, (30.0, 45.0, 60.0, 75.0, 80.0),
+          64, 4, 65536),
 )
 
 #: results.csv: one row per height map x variant x angle x tracer (the numpy twin; the GPU renderer where a
@@ -127,9 +136,10 @@ def load(name: str, size: int, workdir: Path):
 
 
 def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str | None = None,
-        progress: bool = True, command: str = "wgpuviewer refined-distance") -> Results:
+        progress: bool = True, command: str = "wgpuviewer refined-distance", only: str = "") -> Results:
     """Measure every variant of ``SUITES[suite_name]``, Donnelly's regime and the map formats; write ``out``/
-    results.csv, donnelly.csv, formats.csv, format_costs.csv, the picture and report.md (after each part)."""
+    results.csv, donnelly.csv, formats.csv, format_costs.csv, the picture and report.md (after each part). First
+    the worked example and the bound (example.csv, bounded.csv, bounded_maps.csv), alone with ``only="bounded"``."""
     from tqdm import tqdm
 
     from wgpuviewer.core.gpu import get_gpu
@@ -145,43 +155,68 @@ def run(suite_name: str, out: Path, heightmaps=None, angles=None, backend: str |
     out = Path(out)  # checked and made by the command first (harness.study.run_study)
 
     def write():
-        _write(out, res, clock.header(TITLE, command, gpu.summary, suite.name))
+        _write(out, res, clock.header(TITLE, command, gpu.summary, suite.name), only)
 
     chosen = variants()
     format_maps = tuple(m for m in suite.format_maps if heightmaps is None or m in maps) or maps[:1]
-    steps = len(maps) * (len(chosen) + 1) + len(formats.FORMATS) + len(format_maps) + len(pits.PLATES)
+    exact_maps = tuple(m for m in suite.exact_maps if m not in REAL_MAPS or skimage_available())
+    steps = len(exact_maps) + (0 if only else len(maps) * (len(chosen) + 1) + len(formats.FORMATS) +
+                               len(format_maps) + len(pits.PLATES))
     with tempfile.TemporaryDirectory(prefix="wgpuviewer-refined-") as workdir, \
             tqdm(total=steps, desc="refined-distance", unit="step", disable=not progress) as bar:
-        for name in maps:
-            heightmap = load(name, suite.builtin_size, Path(workdir))
-            _variants(res.rows, heightmap, chosen, suite, angles, gpu, bar)
-            res.donnelly += _donnelly(heightmap, chosen, suite, gpu)
-            bar.update()
-            write()
-
-        def plate_done(rows: list[dict]) -> None:
-            res.pits.extend(rows)
-            bar.update()
-            write()
-
-        def build(height, height_scale, **options):
-            return cached_generate("distance_refined", height, backend="auto", slices=pits.SLICES,
-                                   height_scale=height_scale, **options)
-
-        pits.measure(suite.pit_size, suite.pit_angles, suite.pit_rays, suite.pit_budget, build, plate_done)
-        heights = {n: formats_height(format_maps[0], n, Path(workdir)) for n in suite.format_sizes}
-
-        def built(b: formats.Built) -> None:
-            res.formats.append(vars(b))
-            write()
-
-        formats.measure(heights, gpu, suite.format_budget_s, on_built=built)
-        bar.update(len(formats.FORMATS))
-        for name in format_maps:
-            res.costs += _costs(load(name, suite.builtin_size, Path(workdir)), suite, gpu)
-            bar.update()
-            write()
+        _bound(res, suite, exact_maps, {v.name: v for v in chosen}, out, write, bar)
+        if not only:
+            _main(res, suite, maps, chosen, angles, format_maps, gpu, Path(workdir), write, bar)
     return res
+
+
+def _bound(res: Results, suite: Suite, exact_maps, by_name: dict, out: Path, write, bar) -> None:
+    """The paper's worked example (example.csv, its picture) and the exact-visibility bound on ``exact_maps``."""
+    from wgpuviewer.lab.bench.view import HEIGHT_SCALE
+
+    res.example = example.solve()
+    res.cuts = {n: example.conservative_cut(n) for n in example.CUT_SECTORS}
+    res.example_plotted = example.plot(res.example, res.cuts, out / example.PLOT)
+    example.TABLE.write(out / "example.csv", [example.row(res.example, res.cuts)])
+    for name in exact_maps:
+        rows, bound = bounded.measure(name, suite, lambda v, h: _build(by_name[v], h, HEIGHT_SCALE)[0])
+        res.bounded += rows
+        res.bounded_maps += bound
+        bar.update()
+        write()
+
+
+def _main(res: Results, suite: Suite, maps, chosen, angles, format_maps, gpu, workdir: Path, write, bar) -> None:
+    """Every variant on the main maps with Donnelly's regime, the deeper plates, the map formats and their costs."""
+    for name in maps:
+        heightmap = load(name, suite.builtin_size, workdir)
+        _variants(res.rows, heightmap, chosen, suite, angles, gpu, bar)
+        res.donnelly += _donnelly(heightmap, chosen, suite, gpu)
+        bar.update()
+        write()
+
+    def plate_done(rows: list[dict]) -> None:
+        res.pits.extend(rows)
+        bar.update()
+        write()
+
+    def build(height, height_scale, **options):
+        return cached_generate("distance_refined", height, backend="auto", slices=pits.SLICES,
+                               height_scale=height_scale, **options)
+
+    pits.measure(suite.pit_size, suite.pit_angles, suite.pit_rays, suite.pit_budget, build, plate_done)
+    heights = {n: formats_height(format_maps[0], n, workdir) for n in suite.format_sizes}
+
+    def built(b: formats.Built) -> None:
+        res.formats.append(vars(b))
+        write()
+
+    formats.measure(heights, gpu, suite.format_budget_s, on_built=built)
+    bar.update(len(formats.FORMATS))
+    for name in format_maps:
+        res.costs += _costs(load(name, suite.builtin_size, workdir), suite, gpu)
+        bar.update()
+        write()
 
 
 def formats_height(name: str, size: int, workdir: Path) -> np.ndarray:
@@ -291,8 +326,15 @@ def _costs(heightmap, suite: Suite, gpu) -> list[dict]:
 
 
 
-def _write(out: Path, res: Results, header: Header) -> None:
-    """The CSV files, the picture and report.md of the results so far (rewritten after each part)."""
+def _write(out: Path, res: Results, header: Header, only: str = "") -> None:
+    """The CSV files, the picture and report.md of the results so far (rewritten after each part); with ``only``
+    the bound's files alone."""
+    if res.bounded:
+        bounded.TABLE.write(out / "bounded.csv", res.bounded)
+        bounded.MAPS_TABLE.write(out / "bounded_maps.csv", res.bounded_maps)
+    if only:
+        write_bytes(out / "report.md", report(res, header, None).encode())
+        return
     TABLE.write(out / "results.csv", res.rows)
     DONNELLY_TABLE.write(out / "donnelly.csv", res.donnelly)
     FORMATS_TABLE.write(out / "formats.csv", res.formats)
