@@ -112,8 +112,8 @@ def test_a_load_reports_its_progress(tmp_path, monkeypatch):
     seen = []
 
     class Progress:
-        def __init__(self, what):
-            seen.append(what)
+        def __init__(self, what, unit):
+            seen.append((what, unit))
 
         def __enter__(self):
             return lambda label, done, total: seen.append((label, done, total))
@@ -123,4 +123,4 @@ def test_a_load_reports_its_progress(tmp_path, monkeypatch):
 
     monkeypatch.setattr(files, "terminal_progress", Progress)
     meshes.load_mesh(write_obj(tmp_path))
-    assert seen == ["reading panel.obj", ("parsing", 0, 2), ("checking triangles", 1, 2), ("done", 2, 2)]
+    assert seen == [("reading panel.obj", "step"), ("parsing", 0, 2), ("checking triangles", 1, 2), ("done", 2, 2)]

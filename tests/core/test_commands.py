@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
 import stat
 import subprocess
 import sys
@@ -194,3 +195,20 @@ def test_opencv_warnings_are_silenced(tmp_path):
 def test_the_command_line_is_quoted_as_a_shell_would_need():
     assert commands.command_line("wgpuviewer", ["bench", "--out", "my runs/a", "--suite", "smoke"]) == \
         "wgpuviewer bench --out 'my runs/a' --suite smoke"
+
+
+@pytest.mark.parametrize("signum,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_signal_a_library_turned_into_another_error_still_exits_as_the_signal(signum, code, capsys):
+    """Where Ctrl-C or SIGTERM lands inside a native callback, the library may swallow the interrupt and raise
+    something else (wgpu's device request raised an AssertionError): the exit is still 130/143, not a bug report."""
+
+    def interrupted_inside_a_library():
+        try:
+            signal.raise_signal(signum)
+        except KeyboardInterrupt:
+            raise AssertionError("promise still pending") from None
+        return 0
+
+    assert commands.run_command("wgpuviewer", interrupted_inside_a_library) == code
+    assert "internal error" not in capsys.readouterr().err
+    assert commands.run_command("wgpuviewer", lambda: 1 // 0) == 3  # without a signal, a bug is a bug

@@ -194,6 +194,9 @@ def run_command(prog: str, command: Callable[[], int]) -> int:
             print(f"{prog}: interrupted", file=sys.stderr)
             return 130
         except Exception as error:  # noqa: BLE001 - the one place that reports bugs
+            if _received:  # an interrupt raised inside a native callback (wgpu's) resurfaces as another error
+                print(f"{prog}: {'terminated' if _received[-1] == signal.SIGTERM else 'interrupted'}", file=sys.stderr)
+                return 143 if _received[-1] == signal.SIGTERM else 130
             return report_internal_error(prog, error)
 
 
@@ -202,23 +205,38 @@ class Terminated(KeyboardInterrupt):
     (atomic writes remove their temps, worker pools shut down); ``run_command`` exits 143 for it."""
 
 
+_received: list[int] = []  # the signals a command's handlers raised for, newest last
+
+
 def _raise_terminated(signum, frame):
+    _received.append(signum)
     raise Terminated
+
+
+def _raise_interrupted(signum, frame):
+    _received.append(signum)
+    raise KeyboardInterrupt
 
 
 @contextlib.contextmanager
 def sigterm_unwinds():
     """While inside, SIGTERM raises ``Terminated`` in the main thread instead of ending the process where it stands
-    (Python's default, which runs no ``finally`` and leaves temp files behind); the previous handler comes back
-    after. Only the main thread may set handlers: from another thread this changes nothing."""
+    (Python's default, which runs no ``finally`` and leaves temp files behind), SIGINT raises KeyboardInterrupt, and
+    both are remembered in ``_received``; the previous handlers come back after. Only the main thread may set
+    handlers: from another thread this changes nothing."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    # SIGINT raises KeyboardInterrupt as Python's own handler does, and is remembered: where it lands inside a
+    # native callback, the library may turn it into another error (run_command still exits 130 for it)
+    previous_int = signal.signal(signal.SIGINT, _raise_interrupted)
+    _received.clear()
     try:
         yield
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
+        signal.signal(signal.SIGINT, signal.default_int_handler if previous_int is None else previous_int)
 
 
 def report_internal_error(prog: str, error: BaseException) -> int:

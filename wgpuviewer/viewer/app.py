@@ -29,9 +29,9 @@ import numpy as np
 import wgpu
 
 from wgpuviewer.camera import normalize
+from wgpuviewer.core import gpu as core_gpu
 from wgpuviewer.core.commands import terminal_progress
 from wgpuviewer.core.errors import InputError, UserError
-from wgpuviewer.core.gpu import get_gpu
 from wgpuviewer.relief.filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, FILTERS, get_filter
 from wgpuviewer.relief.output import save_rgb_png
 from wgpuviewer.relief.renderer import DrawConfig, Renderer
@@ -75,7 +75,7 @@ class Viewer:
         s = self.settings
         self.scene = scene
         prepare_gpu(gui)  # before the first adapter request: the window's surface must work with its adapter
-        self.gpu = get_gpu(backend)
+        self.gpu = core_gpu.get_gpu(backend)  # looked up at the call: tests stand in for it
         self.renderer = Renderer(scene, self.gpu)
         # What the first technique needs is built before the window opens (a bad file: one line, exit 2).
         with terminal_progress(f"maps for {technique}") as progress:

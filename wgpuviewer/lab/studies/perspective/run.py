@@ -41,6 +41,7 @@ from wgpuviewer.lab.harness.table import Column, Table, columns
 from . import threads_report, tieback
 from .geometry import Quad, Reference, Setup, Spans, at_footprint, build, reference, tiles_of
 from .methods import METHODS, Result, evaluate, ops_per_texel
+from .threaded import THREADS_TABLE
 
 SWEEP_TILT = 80.0  # degrees at the far end of the span: a grazing wall, still well before edge-on
 FOOTPRINT = 1.0  # texels per pixel at every configuration's middle pixel
@@ -486,7 +487,7 @@ def run(suite_name: str, out: Path, backend: str | None = None, progress: bool =
     TABLE.write(out / "results.csv", study.rows)
     ALONG_TABLE.write(out / "along_span.csv", study.along)
     TIEBACK_TABLE.write(out / "tieback.csv", relief)
-    threads_report.THREADS_TABLE.write(out / threads_report.THREADS_FILE, threads)
+    THREADS_TABLE.write(out / threads_report.THREADS_FILE, threads)
     meta = {
         "header": clock.header(TITLE, command, study.gpu.summary, suite.name),
         "suite": suite, "software": study.gpu.software, "threads": threads, "cpu": cpu_model(),
