@@ -17,7 +17,10 @@ const MODE_LAYER_DEPTH: u32 = 3u;  // the hit's layer depth t in the relief, 0 =
 const MODE_LAYERS: u32 = 4u;
 const MODE_ALBEDO: u32 = 5u;  // the filtered albedo, unlit (the filtering study compares it)
 
-@group(0) @binding(0) var<uniform> frame: Frame;
+// Read-only storage, not uniform: the frame changes every frame and steers control flow (mode, light count), and
+// Mesa 22's lavapipe recompiles a fragment shader, never freeing the old one, whenever a uniform buffer feeding its
+// branches is rebound with new values (0.6-24 MB and up to 0.1 s a frame). Storage buffers are never inlined.
+@group(0) @binding(0) var<storage, read> frame: Frame;
 @group(2) @binding(0) var<uniform> object: Object;
 
 struct VertexIn {
