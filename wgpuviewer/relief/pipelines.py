@@ -47,8 +47,7 @@ class Pipelines:
         self._techniques: dict[str, Technique] = {}  # the technique of each name in the cache
         self._material_layouts: dict[tuple[str, ...], wgpu.GPUBindGroupLayout] = {}
         self.frame_layout = device.create_bind_group_layout(
-            label="frame",  # read-only storage: see entry/render.wgsl
-            entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "read-only-storage"}}]
+            label="frame", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]
         )
         self.object_layout = device.create_bind_group_layout(
             label="object", entries=[{"binding": 0, "visibility": V | F, "buffer": {"type": "uniform"}}]

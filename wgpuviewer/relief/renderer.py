@@ -127,7 +127,7 @@ class Renderer:
             self._depth_ranges: dict[str, tuple[float, float]] = {}
         device = gpu.device
         U = wgpu.BufferUsage
-        self._frame_buffer = device.create_buffer(label="frame", size=FRAME.size, usage=U.STORAGE | U.COPY_DST)
+        self._frame_buffer = device.create_buffer(label="frame", size=FRAME.size, usage=U.UNIFORM | U.COPY_DST)
         self._lights = scene_lights(scene)  # fixed for the scene: packed once, not per frame
         self._frame_group = device.create_bind_group(
             layout=self.pipelines.frame_layout, entries=[{"binding": 0, "resource": {"buffer": self._frame_buffer}}]

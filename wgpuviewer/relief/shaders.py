@@ -27,9 +27,8 @@ from .filters import DEFAULT_DERIVATIVES, DEFAULT_FILTER, filter_interface, get_
 from .maps import MAP_SLOTS, PARAMS_BINDING, SAMPLER_BINDING, binding
 from .reference import SHADOW_TOLERANCE_TEXELS, SOFT_SHADOW_PENUMBRA, SOFT_SHADOW_SAMPLES
 
-#: The render entry's records (``entry/render.wgsl``): group 0's Frame (camera, view mode, lights; MAX_LIGHTS, the
-#: scene format's limit, sizes its light array; a read-only storage buffer, see render.wgsl) and group 2's Object
-#: uniform, generated into the render interface.
+#: The render entry's uniforms (``entry/render.wgsl``): group 0's Frame (camera, view mode, lights; MAX_LIGHTS, the
+#: scene format's limit, sizes its light array) and group 2's Object, generated into the render interface.
 LIGHT = Struct("Light", [
     ("vector", "vec4f"),  # w = 0: direction towards the light; w = 1: light position
     ("color", "vec4f"),  # rgb * intensity
@@ -43,7 +42,7 @@ FRAME = Struct("Frame", [
     ("layer_lo", "f32"),  # MODE_LAYERS grey: (N - layer_lo) / (layer_hi - layer_lo) (Technique.layer_range)
     ("layer_hi", "f32"),
     ("lights", array(LIGHT, MAX_LIGHTS)),
-], address_space="storage")
+])
 OBJECT = Struct("Object", [
     ("model", "mat4x4f"),
     ("normal_matrix", "mat4x4f"),

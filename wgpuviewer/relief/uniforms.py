@@ -17,7 +17,7 @@ MODES = {"color": 0, "cost": 1, "uv": 2, "layer_depth": 3, "layers": 4, "albedo"
 
 
 def scene_lights(scene) -> np.ndarray:
-    """The Frame buffer's light records (LIGHT, MAX_LIGHTS of them; unused ones zero) for ``scene``'s lights."""
+    """The Frame uniform's light records (LIGHT, MAX_LIGHTS of them; unused ones zero) for ``scene``'s lights."""
     lights = np.zeros(MAX_LIGHTS, LIGHT.dtype)
     for i, light in enumerate(scene.lights):  # the scene checked the count (MAX_LIGHTS)
         if light.type == "directional":
@@ -30,7 +30,7 @@ def scene_lights(scene) -> np.ndarray:
 
 def frame_data(scene: Scene, lights: np.ndarray, camera: Camera, size: tuple[int, int], mode: str,
                technique: Technique, params: dict) -> bytes:
-    """The Frame record of one frame: ``camera`` at the aspect of ``size``, ``mode``, the cost and layers views'
+    """The Frame uniform of one frame: ``camera`` at the aspect of ``size``, ``mode``, the cost and layers views'
     scales of ``technique`` at ``params``, and ``lights`` (``scene_lights``)."""
     w, h = size
     view_proj = cam.perspective(camera.fov, w / h, camera.near, camera.far) @ cam.look_at(

@@ -1,4 +1,4 @@
-"""What a scene may hold: the format's limits (``MAX_LIGHTS``: the renderer's Frame buffer holds that many) and
+"""What a scene may hold: the format's limits (``MAX_LIGHTS``: the renderer's Frame uniform holds that many) and
 the geometry float32 renders correctly (``MAX_DEPTH_RANGE``, ``MAX_VIEW_RATIO``, ``MAX_TEXEL_COORDINATE``), with
 the checks against them (``check_geometry``, ``texel_coordinate_problem``, ``uv_scale_problem``).
 """
@@ -17,7 +17,7 @@ from wgpuviewer.textures import TextureRef
 from .model import Camera, Material, SceneObject
 from .table import show_value
 
-#: Most [[lights]] a scene may have: the renderer's Frame buffer holds them all (32 bytes each), and the
+#: Most [[lights]] a scene may have: the renderer's Frame uniform holds them all (32 bytes each), and the
 #: shader loops over the scene's count only.
 MAX_LIGHTS = 256
 #: camera.far / camera.near at most: reversed-Z float depth separates surfaces over this range.

@@ -17,10 +17,7 @@ const MODE_LAYER_DEPTH: u32 = 3u;  // the hit's layer depth t in the relief, 0 =
 const MODE_LAYERS: u32 = 4u;
 const MODE_ALBEDO: u32 = 5u;  // the filtered albedo, unlit (the filtering study compares it)
 
-// Read-only storage, not uniform: the frame changes every frame and steers control flow (mode, light count), and
-// Mesa 22's lavapipe recompiles a fragment shader, never freeing the old one, whenever a uniform buffer feeding its
-// branches is rebound with new values (0.6-24 MB and up to 0.1 s a frame). Storage buffers are never inlined.
-@group(0) @binding(0) var<storage, read> frame: Frame;
+@group(0) @binding(0) var<uniform> frame: Frame;
 @group(2) @binding(0) var<uniform> object: Object;
 
 struct VertexIn {
@@ -36,6 +33,12 @@ struct VertexOut {
     @location(1) normal: vec3f,
     @location(2) tangent: vec4f,
     @location(3) uv: vec2f,
+    // The frame's values that steer the fragment shader's branches reach it as flat inputs, not as uniform loads:
+    // Mesa 22's lavapipe recompiles a fragment shader whose branches read a uniform buffer each time that buffer is
+    // rebound with new values (every frame), and keeps every copy (0.6-24 MB and up to 0.1 s a frame). A storage
+    // buffer avoids that too, but llvmpipe then runs the ray searches up to 30x slower.
+    @location(4) @interpolate(flat) mode: u32,
+    @location(5) @interpolate(flat) light_count: u32,
 }
 
 @vertex
@@ -48,6 +51,8 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.tangent = vec4f((object.model * vec4f(in.tangent.xyz, 0.0)).xyz, in.tangent.w);
     // glTF's KHR_texture_transform order: scale, then offset (only its fraction: the renderer drops whole tiles)
     out.uv = in.uv * object.uv_transform.xy + object.uv_transform.zw;
+    out.mode = frame.mode;
+    out.light_count = frame.light_count;
     return out;
 }
 
@@ -127,12 +132,12 @@ fn shade(in: VertexOut) -> Shaded {
 
     let fp = Footprint(hit.uv, derivs.dx, derivs.dy, v_ts, lod);
     let albedo = filter_texture(albedo_tex, fp).rgb;
-    if frame.mode == MODE_ALBEDO {
+    if in.mode == MODE_ALBEDO {
         return Shaded(albedo, hit);
     }
     let n = shading_normal(fp);
     var color = 0.2 * albedo;
-    for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
+    for (var i = 0u; i < min(in.light_count, MAX_LIGHTS); i++) {
         let light = frame.lights[i];
         var to_light = light.vector.xyz;
         var radiance = light.color.rgb;
@@ -158,8 +163,8 @@ fn layer_grey(n: u32) -> f32 {
 }
 
 // Window/surface output: one target, the Frame.mode decides what is shown.
-fn fs_color_of(s: Shaded) -> vec4f {
-    switch frame.mode {
+fn fs_color_of(in: VertexOut, s: Shaded) -> vec4f {
+    switch in.mode {
         case MODE_COST: { return vec4f(heat(f32(s.hit.fetches) / frame.cost_scale), 1.0); }
         case MODE_UV: { return vec4f(fract(s.hit.uv), 0.0, 1.0); }
         case MODE_LAYER_DEPTH: { return vec4f(vec3f(s.hit.depth), 1.0); }
@@ -171,7 +176,7 @@ fn fs_color_of(s: Shaded) -> vec4f {
 
 @fragment
 fn fs_color(in: VertexOut) -> @location(0) vec4f {
-    return fs_color_of(shade(in));
+    return fs_color_of(in, shade(in));
 }
 
 // The window's camera-depth view (renderer.MODES["depth"]): its own entry point, because the derivatives it takes
@@ -215,7 +220,7 @@ struct ColorHitDepth {
 @fragment
 fn fs_color_hit_depth(in: VertexOut) -> ColorHitDepth {
     let s = shade(in);
-    return ColorHitDepth(fs_color_of(s), hit_frag_depth(in, s.hit));
+    return ColorHitDepth(fs_color_of(in, s), hit_frag_depth(in, s.hit));
 }
 
 @fragment

@@ -2,7 +2,7 @@
 coverage, rendered in batches into array textures: one submit and two read-backs (colour for the coverage, data)
 per batch, where ``Renderer.render`` takes a submit and three read-backs per configuration.
 
-Draws recorded into one submit share the renderer's frame buffer (camera, mode): they are all of the same view.
+Draws recorded into one submit share the renderer's frame uniform (camera, mode): they are all of the same view.
 """
 
 from __future__ import annotations
