@@ -1,10 +1,9 @@
-"""Command line: ``wgpuviewer view|render|warm|techniques|filters|accuracy|info`` here, and the measuring commands:
+"""Command line: ``wgpuviewer view|render|warm|techniques|filters|info`` here, and the measuring commands:
 ``bench`` and every study under ``wgpuviewer/lab/studies/`` (found by the harness, each registering itself)."""
 
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 from pathlib import Path
@@ -190,61 +189,6 @@ def cmd_filters(args) -> int:
     return 0
 
 
-def cmd_accuracy(args) -> int:
-    if args.rays < 1:
-        raise UserError(f"--rays {args.rays}: expected at least 1 ray")
-    if not (math.isfinite(args.height_scale) and 0 < args.height_scale <= 1):
-        raise UserError(f"--height-scale {args.height_scale}: expected a relief depth in (0, 1] UV units")
-    if args.texels < 1:
-        raise UserError(f"--texels {args.texels}: expected at least 1 texel")
-    if args.doc:
-        refuse_directory(args.doc, "accuracy.md")
-    from tqdm import tqdm
-
-    from wgpuviewer.core.io import write_bytes
-    from wgpuviewer.relief.accuracy import (
-        DEFAULT_ANGLES,
-        DEFAULT_SETTINGS,
-        SHADOW_ELEVATIONS,
-        markdown_report,
-        run,
-        shadow_run,
-        shadowing_techniques,
-        table,
-    )
-
-    from .textures import BUILTINS, builtin_height
-
-    for name in args.heightmaps:
-        if name not in BUILTINS:
-            raise UserError(f"--heightmaps: unknown builtin {name!r}; expected some of {', '.join(BUILTINS)}")
-    maps = {name: builtin_height(name, (args.texels, args.texels)) for name in args.heightmaps}
-    total = len(maps) * len(DEFAULT_SETTINGS) * len(DEFAULT_ANGLES)
-    if args.doc:  # the report adds every shadowing technique's self-shadowing at each light elevation
-        total += len(maps) * len(shadowing_techniques()) * len(SHADOW_ELEVATIONS)
-    from wgpuviewer.core.gpu import get_gpu
-
-    gpu = get_gpu(args.backend)
-    with tqdm(total=total, desc="probe vs reference", file=sys.stderr, leave=False) as bar:
-        if args.doc:
-            measured = run(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend,
-                           progress=bar.update)
-            shadows = shadow_run(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend,
-                                 progress=bar.update)
-        else:
-            text = table(maps, height_scale=args.height_scale, rays=args.rays, backend=args.backend,
-                         progress=bar.update)
-    if args.doc:
-        report = markdown_report(measured, command=args.command_line, adapter=gpu.summary, shadows=shadows)
-        write_bytes(args.doc, report.encode("utf-8"))
-        print(args.doc)
-        return 0
-    print(f"Adapter: {gpu.summary}; height_scale {args.height_scale}; {args.rays} random rays per row; "
-          f"{args.texels}x{args.texels} maps; errors over rays that were not capped.\n")
-    print(text)
-    return 0
-
-
 def cmd_info(args) -> int:
     from wgpuviewer.core.gpu import describe_adapters
 
@@ -397,18 +341,6 @@ def build_parser() -> tuple[argparse.ArgumentParser, tuple[str, ...]]:
 
     filters = sub.add_parser("filters", help="list texture filters, their parameters and the derivative sources")
     filters.set_defaults(func=cmd_filters)
-
-    accuracy = sub.add_parser("accuracy", help="probe each ray-search technique against the float64 reference")
-    accuracy.add_argument("--heightmaps", nargs="+", default=["bricks", "bumps", "checker"], metavar="NAME",
-                          help="builtin height maps to measure on (default: bricks bumps checker)")
-    accuracy.add_argument("--texels", type=int, default=256, help="map size in texels, square (default %(default)s)")
-    accuracy.add_argument("--rays", type=int, default=4096, help="random rays per row (default %(default)s)")
-    accuracy.add_argument("--height-scale", type=float, default=0.05,
-                          help="relief depth in UV units (default %(default)s)")
-    add_backend_option(accuracy)
-    accuracy.add_argument("--doc", metavar="PATH",
-                          help="write the markdown report (docs/accuracy.md) to PATH instead of printing the table")
-    accuracy.set_defaults(func=cmd_accuracy)
 
     for study in measurement_commands():
         register(sub, study)
