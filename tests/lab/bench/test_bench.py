@@ -108,6 +108,22 @@ def test_entry_uv_matches_the_rendered_uv(tmp_path, gpu):
         assert err < 0.05, (angle, err)
 
 
+def test_a_scikit_image_map_is_downscaled_written_and_drawn_from_its_file(tmp_path, gpu):
+    """The real maps (the smoke suite's brick; the smoke test below runs builtins only) load area-downscaled to
+    ``real_size``, go to the scene as a PNG file and draw with the view's entry uv."""
+    if not bench.skimage_available():
+        pytest.skip("scikit-image is not installed (the test extra has it)")
+    hm = load_heightmap("brick", 64, tmp_path, real_size=96)
+    assert max(hm.size) == 96 and hm.height.dtype == np.float32 and 0 <= hm.height.min() < hm.height.max() <= 1
+    assert "downscaled to" in hm.source
+    (png,) = tmp_path.glob("skimage_brick_*.png")
+    assert str(png) in hm.texture
+    view = make_view(hm, 45.0, (40, 24))
+    image = Renderer(view.scene, gpu).render("basic", view.size)
+    assert image.covered.all()
+    assert np.abs(image.data[..., :2] - view.uv0).max() * 96 < 0.05
+
+
 # --- report logic -------------------------------------------------------------------------------
 
 def _row(technique, params, angle, ratio, p95, heightmap="m", ms=None):
@@ -282,19 +298,27 @@ def test_cli_rejects_bad_options(tmp_path, capsys):
         assert err.startswith("wgpuviewer: error: --") and "Traceback" not in err
 
 
+#: The smoke suite narrowed by the command's options (two builtin maps, two angles, 3 frames): every technique
+#: and sweep setting still runs through maps, timing, capture, reference, report and plots, in a fraction of the
+#: whole suite's time (the committed llvmpipe-smoke run is the whole suite).
+SMOKE_MAPS, SMOKE_ANGLES, SMOKE_FRAMES = ("bricks", "spike"), (0.0, 60.0), 3
+
+
 def test_smoke_suite_writes_complete_sane_outputs(tmp_path, gpu):
     from wgpuviewer.cli import main
 
     out = tmp_path / "bench"
-    assert main(["bench", "--suite", "smoke", "--out", str(out), "--quiet"]) == 0
+    argv = ["bench", "--suite", "smoke", "--out", str(out), "--heightmaps", ",".join(SMOKE_MAPS),
+            "--angles", ",".join(f"{a:g}" for a in SMOKE_ANGLES), "--frames", str(SMOKE_FRAMES), "--quiet"]
+    assert main(argv) == 0
     rows = bench.TABLE.read(out / "results.csv")
     suite = bench.SUITES["smoke"]
-    maps = [m for m in suite.heightmaps if m not in bench.REAL_MAPS or bench.skimage_available()]
     configs = bench.configs_for(list(TECHNIQUES), suite.sweeps)
-    assert len(rows) == len(maps) * len(suite.angles) * len(configs)
+    assert len(rows) == len(SMOKE_MAPS) * len(SMOKE_ANGLES) * len(configs)
+    assert {(r["heightmap"], r["angle"]) for r in rows} == {(m, a) for m in SMOKE_MAPS for a in SMOKE_ANGLES}
     assert list(rows[0]) == list(bench.COLUMNS)
     for r in rows:
-        assert r["gpu_ms"] > 0 and r["basic_ms"] > 0 and r["adapter"] and r["frames"] == suite.frames
+        assert r["gpu_ms"] > 0 and r["basic_ms"] > 0 and r["adapter"] and r["frames"] == SMOKE_FRAMES
         assert r["angle_min"] - 0.1 <= r["angle"] <= r["angle_max"] + 0.1
         assert 0 <= r["capped_fraction"] <= 1 and 0 < r["covered_fraction"] <= 1
         assert r["fetches_p95"] >= 0 and r["fetches_mean"] >= 0 and r["fetches_simd"] >= 0
@@ -317,7 +341,7 @@ def test_smoke_suite_writes_complete_sane_outputs(tmp_path, gpu):
     assert "SIMD-tile fetches" in report and "the SIMD-tile fetches" in report  # the comparison with distance
     assert rows[0]["adapter"] in report
     assert report.startswith("# wgpuviewer benchmark: speed against error (smoke suite)\n\n- command: "
-                             f"`wgpuviewer bench --suite smoke --out {out} --quiet`\n- adapter: **")
+                             f"`wgpuviewer {' '.join(argv)}`\n- adapter: **")
     if "pom_adaptive" in TECHNIQUES:
         assert "Speed-up of adaptive POM" in report
     else:

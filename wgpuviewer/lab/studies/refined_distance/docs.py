@@ -9,7 +9,15 @@
 - ``refined distance worked example`` (maps.md): the paper's point C rebuilt (the bound's run,
   ``benchmarks/refined_distance/bounded/``: example.csv, worked_example.png);
 - ``refined distance bounded`` (maps.md): per map class, what the exact-visibility bound saves and what the
-  conservative cut gets of it (the bound's run: bounded.csv, bounded_maps.csv)."""
+  conservative cut gets of it (the bound's run: bounded.csv, bounded_maps.csv);
+- ``refined distance cost`` (maps.md): every map's fetches per height map and angle with the changes, the GPU
+  renderer's agreement with the twin, the capped pixels;
+- ``refined distance result``, ``... ablation`` (maps.md): what the condition and the bins change, and each bin
+  layout against ``distance``;
+- ``refined distance pits`` (maps.md): the condition on deeper and wider holes (pits.csv);
+- ``refined distance storage`` (maps.md): float16 / float32 / 8-bit plain maps (results.csv, donnelly.csv);
+- ``refined distance formats`` (maps.md): memory, build time and cost per map format (the report's table).
+They compute from the committed CSVs and measure nothing."""
 
 from __future__ import annotations
 
@@ -18,8 +26,10 @@ from pathlib import Path
 
 from wgpuviewer.lab.harness.blocks import Block
 
-from . import bounded, example
-from .run import FORMATS_TABLE, TABLE
+from . import bounded, example, pits
+from .report import formats_markdown
+from .run import COSTS_TABLE, DONNELLY_TABLE, FORMATS_TABLE, TABLE
+from .variants import CONDITION_PAIRS, OTHER_STORAGES, SINGLE_CONE
 
 RUN = "benchmarks/refined_distance"
 #: The bound's run (``--only bounded``): the worked example and the exact-visibility maps.
@@ -148,9 +158,201 @@ def bounded_body(root: Path) -> str:
     return "\n".join(lines)
 
 
+# --- docs/maps.md "Measured cost": the run's tables and what they say ---------------------------------------------
+
+def _twins(root: Path) -> dict[tuple[str, float, str], dict]:
+    """(map, angle, variant) -> the numpy twin's row."""
+    return {(r["heightmap"], r["angle"], r["variant"]): r for r in TABLE.read(root / RUN / "results.csv")
+            if r["tracer"] == TWIN}
+
+
+def _ratio(by: dict, name: str, angle: float, a: str, b: str, key: str = "fetches_mean") -> float | None:
+    x, y = by.get((name, angle, a)), by.get((name, angle, b))
+    return x[key] / y[key] - 1.0 if x and y and y[key] else None
+
+
+def _pct(x: float | None) -> str:
+    return "-" if x is None else f"{100 * x:+.0f} %"
+
+
+def _pcts(values, digits: int = 0) -> str:
+    """The range of the changes ``values`` (fractions) in percent."""
+    lo, hi = 100 * min(values), 100 * max(values)
+    return f"{lo:+.{digits}f} %" if f"{lo:.{digits}f}" == f"{hi:.{digits}f}" else f"{lo:+.{digits}f} to {hi:+.{digits}f} %"
+
+
+def _share(x: float) -> str:
+    return "<0.1 %" if x < 0.0005 else f"{100 * x:.1f} %"
+
+
+def _maps_angles(by: dict) -> tuple[list[str], list[float]]:
+    return (list(dict.fromkeys(k[0] for k in by)), sorted({k[1] for k in by}))
+
+
+#: The cost table's columns: (label, variant) and its changes (label, variant, against).
+COST_COLUMNS = (("baseline", BASELINE), ("`distance`", DISTANCE), ("single cone", SINGLE_CONE),
+                ("single cone, visibility on", CONDITION_PAIRS[0][0]), ("`distance_refined`", REFINED),
+                ("`distance_refined`, visibility on", CONDITION_PAIRS[1][0]))
+COST_CHANGES = (("`distance` vs baseline", DISTANCE, BASELINE), ("refined vs baseline", REFINED, BASELINE),
+                ("refined vs `distance`", REFINED, DISTANCE))
+
+
+def cost_body(root: Path) -> str:
+    """Every product-relevant map's fetches (mean / SIMD-tile) per map and angle, the changes, the GPU renderer's
+    agreement with the twin and the capped pixels."""
+    by = _twins(root)
+    maps, angles = _maps_angles(by)
+    head = [c[0] for c in COST_COLUMNS] + [c[0] for c in COST_CHANGES]
+    lines = ["", f"`{RUN}/results.csv`, the numpy twin (fetches mean / SIMD-tile; changes mean / SIMD-tile):", "",
+             "| map | angle | " + " | ".join(head) + " |", "|---|---|" + "---|" * len(head)]
+    for name in maps:
+        for angle in angles:
+            cells = []
+            for _, variant in COST_COLUMNS:
+                r = by.get((name, angle, variant))
+                cells.append("-" if r is None else f"{r['fetches_mean']:.2f} / {r['fetches_simd']:.2f}")
+            for _, a, b in COST_CHANGES:
+                cells.append(f"{_pct(_ratio(by, name, angle, a, b))} / "
+                             f"{_pct(_ratio(by, name, angle, a, b, 'fetches_simd'))}")
+            lines.append(f"| {name} | {angle:g}° | " + " | ".join(cells) + " |")
+    rows = TABLE.read(root / RUN / "results.csv")
+    gpu = [(r, by.get((r["heightmap"], r["angle"], r["variant"]))) for r in rows if r["tracer"] != TWIN]
+    gpu = [(g, t) for g, t in gpu if t and t["fetches_mean"]]
+    lines.append("")
+    for label, test in (("at 0-60°", lambda a: a <= 60), ("from 75° on", lambda a: a >= 75)):
+        diff = [abs(g["fetches_mean"] / t["fetches_mean"] - 1.0) for g, t in gpu if test(g["angle"])]
+        if diff:
+            lines.append(f"The GPU renderer's mean fetches {label} differ from the twin's by at most "
+                         f"{100 * max(diff):.3g} % ({len(diff)} rows).")
+    capped = [r for r in by.values() if r["capped"]]
+    lines.append("The twin capped no pixel." if not capped else "Pixels the twin capped: " + "; ".join(
+        f"{r['variant']} on {r['heightmap']} at {r['angle']:g}° {_share(r['capped'])}" for r in capped) + ".")
+    return "\n".join(lines) + "\n"
+
+
+def result_body(root: Path) -> str:
+    """What the condition and the bins change, over the run's maps and angles."""
+    by = _twins(root)
+    maps, angles = _maps_angles(by)
+
+    def over(a, b, at=None):
+        return [x for m in maps for g in (at or angles) if (x := _ratio(by, m, g, a, b)) is not None]
+
+    (single_on, single), (binned_on, binned) = CONDITION_PAIRS
+    return "\n".join([
+        "",
+        f"- The paper's condition on the single cone changes its mean fetches by {_pcts(over(single_on, single), 2)} "
+        f"over the run's maps and angles ({', '.join(maps)}; {', '.join(f'{a:g}' for a in angles)}°); the single "
+        f"cone without it is within {_pcts(over(single, DISTANCE), 2)} of `distance`; on the binned map the condition "
+        f"changes {_pcts(over(binned_on, binned), 2)}.",
+        "- `distance_refined` against `distance`: " + ", ".join(
+            f"{_pcts(over(REFINED, DISTANCE, (a,)))} at {a:g}°" for a in (45.0, 60.0, 80.0)) +
+        "; against the baseline: " + ", ".join(
+            f"{_pcts(over(REFINED, BASELINE, (a,)))} at {a:g}°" for a in (45.0, 60.0, 80.0)) +
+        f"; `distance` against the baseline: {_pcts(over(DISTANCE, BASELINE, (45.0,)))} at 45°, "
+        f"{_pcts(over(DISTANCE, BASELINE, (75.0, 80.0)))} at 75-80°.",
+        ""])
+
+
+def pits_body(root: Path) -> str:
+    """The condition on deeper and wider holes (``pits.csv``): its largest saving per bin layout, and Donnelly's
+    error with and without it."""
+    rows = pits.TABLE.read(root / RUN / "pits.csv")
+    by = {(r["plate"], r["angle"], r["bins"], r["visibility"]): r for r in rows}
+    lines = ["", f"`{RUN}/pits.csv`: plates {rows[0]['size']}², {rows[0]['rays']} random rays per plate and angle; "
+             "fetches with the condition on against off:", ""]
+    for bins in dict.fromkeys(r["bins"] for r in rows):
+        pairs = [(by[k[:3] + ("off",)], r) for k, r in by.items() if k[2] == bins and k[3] == "on"
+                 and k[:3] + ("off",) in by]
+        change = [(on["fetches_mean"] / off["fetches_mean"] - 1.0, off, on) for off, on in pairs if off["fetches_mean"]]
+        best, off, on = min(change, key=lambda c: c[0])
+        steep = [c for c, o, _ in change if o["angle"] >= 45.0]
+        donnelly = max(abs(on["error_p95_holes"] - off["error_p95_holes"]) for off, on in pairs)
+        lines.append(f"- {bins} bins: at most {100 * best:+.1f} % of all rays' fetches "
+                     f"({100 * (on['fetches_holes'] / off['fetches_holes'] - 1.0):+.1f} % of the rays that enter a "
+                     f"hole), on {off['plate']} (holes {off['hole_depth']:g} texels deep) at {off['angle']:g}°"
+                     + (f"; at 45° and beyond at most {100 * min(steep):+.1f} %" if steep else "") +
+                     f"; Donnelly's loop at {rows[0]['budget']} iterations: the p95 error of the rays entering a hole "
+                     f"moves by at most {donnelly:.2f} texel with the condition.")
+    return "\n".join(lines + [""])
+
+
+#: The ablation: the plain map on one sub-cell and the refined maps' bin layouts, against `distance`.
+ABLATION = ("plain K=1", "8 sectors x 1 bands", "1 sectors x 8 bands", "2 sectors x 8 bands", REFINED)
+BUILTINS = ("bricks", "bumps", "ridges", "wall")
+
+
+def ablation_body(root: Path) -> str:
+    """Change of mean fetches against `distance` per layout, at 45/60/80°, and how 4 x 8 compares with 8 x 1 and
+    2 x 8."""
+    by = _twins(root)
+    maps, _ = _maps_angles(by)
+    lines = ["", "| map | angle | " + " | ".join(ABLATION) + " |", "|---|---|" + "---|" * len(ABLATION)]
+    for name in maps:
+        for angle in (45.0, 60.0, 80.0):
+            lines.append(f"| {name} | {angle:g}° | " + " | ".join(
+                _pct(_ratio(by, name, angle, v, DISTANCE)) for v in ABLATION) + " |")
+
+    def points(a, b, names):
+        return [100 * (_ratio(by, m, g, b, DISTANCE) - _ratio(by, m, g, a, DISTANCE)) for m in names
+                for g in (45.0, 60.0, 75.0, 80.0) if None not in (_ratio(by, m, g, a, DISTANCE),
+                                                                    _ratio(by, m, g, b, DISTANCE))]
+    sectors = points(REFINED, "8 sectors x 1 bands", [m for m in maps if m in BUILTINS])
+    halves = points(REFINED, "2 sectors x 8 bands", maps)
+    k1 = [x for m in maps for g in (45.0, 60.0, 75.0, 80.0)
+          if (x := _ratio(by, m, g, "plain K=1", DISTANCE)) is not None]
+    wins = sorted({m for m in maps for g in (45.0, 60.0, 80.0)
+                   if (_ratio(by, m, g, "8 sectors x 1 bands", DISTANCE) or 0) < (_ratio(by, m, g, REFINED, DISTANCE) or 0)})
+    lines += ["", f"At 45-80°: one sub-cell (K = 1) costs {_pcts(k1)} against `distance`; 4 x 8 bins take "
+              f"{min(sectors):.0f} to {max(sectors):.0f} points fewer than 8 x 1 on the builtins "
+              f"({', '.join(m for m in maps if m in BUILTINS)}) and {min(halves):.0f} to {max(halves):.0f} points "
+              "fewer than 2 x 8 on every map"
+              + (f"; 8 x 1 beats 4 x 8 on {', '.join(wins)} at some of 45/60/80°." if wins else "."), ""]
+    return "\n".join(lines)
+
+
+def storage_body(root: Path) -> str:
+    """The plain map's storage: float16 as uploaded against float32, Donnelly's 8 bits against float16 (fetches and
+    Donnelly's p95 error at 16 iterations and 60°)."""
+    by = _twins(root)
+    maps, angles = _maps_angles(by)
+    f32, bits8 = OTHER_STORAGES
+
+    def over(a, b, key="fetches_mean"):
+        return [x for m in maps for g in angles if (x := _ratio(by, m, g, a, b, key)) is not None]
+    donnelly = {(r["heightmap"], r["variant"]): r for r in DONNELLY_TABLE.read(root / RUN / "donnelly.csv")
+                if r["regime"] == "fixed" and r["iterations"] == 16 and r["angle"] == 60.0}
+    rise = [(donnelly[(m, bits8)]["error_p95"] - donnelly[(m, DISTANCE)]["error_p95"], m) for m in maps
+            if (m, bits8) in donnelly and (m, DISTANCE) in donnelly]
+    worst = max(rise, default=None)
+    simd = max(over(bits8, DISTANCE, "fetches_simd"))
+    return ("\nThe plain map as the renderer uploads it (float16, rounded down) takes "
+            f"{_pcts(over(DISTANCE, f32), 2)} of float32's fetches; Donnelly's 8 bits take "
+            f"{_pcts(over(bits8, DISTANCE), 1)} of float16's (SIMD-tile at most {100 * simd:+.1f} %)"
+            + ("" if worst is None else
+               f" and raise Donnelly's p95 error at 16 iterations and 60° by up to {worst[0]:.2f} texel ({worst[1]}: "
+               f"{donnelly[(worst[1], DISTANCE)]['error_p95']:.2f} → {donnelly[(worst[1], bits8)]['error_p95']:.2f})")
+            + f" (`{RUN}/`).\n")
+
+
+def formats_body(root: Path) -> str:
+    """The report's map-format table (``report.formats_markdown``)."""
+    built = FORMATS_TABLE.read(root / RUN / "formats.csv")
+    costs = COSTS_TABLE.read(root / RUN / "format_costs.csv")
+    return "\n".join(["", f"`{RUN}/formats.csv` and `format_costs.csv`:", "", *formats_markdown(built, costs), ""])
+
+
 BLOCKS = (Block("docs/maps.md", "refined distance baseline", f"{RUN}/results.csv", baseline_body, results=RUN),
           Block("docs/maps.md", "refined distance bake times", f"{RUN}/formats.csv", bake_body, results=RUN),
           Block("docs/techniques.md", "refined distance savings", f"{RUN}/results.csv", savings_body, results=RUN),
           Block("docs/maps.md", "refined distance worked example", f"{BOUND}/example.csv", example_body, results=BOUND),
           Block("docs/maps.md", "refined distance bounded", f"{BOUND}/bounded.csv and {BOUND}/bounded_maps.csv",
-                bounded_body, results=BOUND))
+                bounded_body, results=BOUND),
+          Block("docs/maps.md", "refined distance cost", f"{RUN}/results.csv", cost_body, results=RUN),
+          Block("docs/maps.md", "refined distance result", f"{RUN}/results.csv", result_body, results=RUN),
+          Block("docs/maps.md", "refined distance pits", f"{RUN}/pits.csv", pits_body, results=RUN),
+          Block("docs/maps.md", "refined distance ablation", f"{RUN}/results.csv", ablation_body, results=RUN),
+          Block("docs/maps.md", "refined distance storage", f"{RUN}/results.csv and {RUN}/donnelly.csv",
+                storage_body, results=RUN),
+          Block("docs/maps.md", "refined distance formats", f"{RUN}/formats.csv and {RUN}/format_costs.csv",
+                formats_body, results=RUN))
