@@ -1,6 +1,6 @@
-"""docs/shadows.md's generated block (``<!-- generated: shadows results -->``): the committed run's tables, made from
-its results.csv and timing.csv by the report's own code (``run.report``, its header left out); ``wgpuviewer docs``
-writes it (``wgpuviewer.lab.docs``)."""
+"""docs/shadows.md's generated blocks: ``shadows results``, the committed run's tables, made from its results.csv and
+timing.csv by the report's own code (``run.report``, its header left out); ``shadows hidden``, the share of the floor
+the timing's wall hides (timing.csv's ``hidden``). ``wgpuviewer docs`` writes them (``wgpuviewer.lab.docs``)."""
 
 from __future__ import annotations
 
@@ -25,4 +25,18 @@ def body(root: Path) -> str:
     return own.strip()
 
 
-BLOCKS = (Block("docs/shadows.md", "shadows results", f"{RUN}/results.csv and timing.csv", body, results=RUN),)
+def hidden_line(times: list[dict]) -> str:
+    """The share of the floor's pixels the occluded scene's wall hides (the same in every row of that scene)."""
+    shares = sorted({r["hidden"] for r in times if r["scene"] == "occluded"})
+    if not shares:
+        return "The run timed no occluded scene."
+    share = f"{shares[0]:.0%}" if len(shares) == 1 else f"{shares[0]:.0%}-{shares[-1]:.0%}"
+    return f"The wall hides {share} of the floor's pixels (`{RUN}/timing.csv`, `hidden`)."
+
+
+def hidden_body(root: Path) -> str:
+    return "\n" + hidden_line(TIMING.read(root / RUN / "timing.csv")) + "\n"
+
+
+BLOCKS = (Block("docs/shadows.md", "shadows hidden", f"{RUN}/timing.csv", hidden_body, results=RUN),
+          Block("docs/shadows.md", "shadows results", f"{RUN}/results.csv and timing.csv", body, results=RUN),)
