@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import cv2
 import numpy as np
@@ -45,9 +46,12 @@ def test_render_png_and_npy(tmp_path, adapter):
 
 
 def test_render_is_byte_identical_across_runs(tmp_path, adapter):
+    """A fresh process (python -m wgpuviewer) and the test process (its device shared with other tests) write the
+    same bytes."""
     a, b = tmp_path / "a.png", tmp_path / "b.png"
-    for out in (a, b):
-        assert run_cli("render", str(ROOT / "scenes" / "default.toml"), "-o", str(out), "--size", "64x40").returncode == 0
+    args = ["render", str(ROOT / "scenes" / "default.toml"), "--size", "64x40", "-o"]
+    assert run_cli(*args, str(a)).returncode == 0
+    assert main([*args, str(b)]) == 0
     assert a.read_bytes() == b.read_bytes()
 
 
@@ -66,8 +70,12 @@ def test_render_is_byte_identical_across_runs(tmp_path, adapter):
         (["bench", "--out", "o", "--heightmaps", ","], ["--heightmaps"]),
     ],
 )
-def test_user_errors_exit_2_with_one_line(tmp_path, args, fragments):
-    assert_user_error(run_cli(*args, cwd=tmp_path), *fragments)
+def test_user_errors_exit_2_with_one_line(tmp_path, monkeypatch, capsys, args, fragments):
+    """In this process (``main`` returns the exit status; the run_cli tests below go through ``python -m
+    wgpuviewer`` and its exit status)."""
+    monkeypatch.chdir(tmp_path)
+    code = main(args)
+    assert_user_error(SimpleNamespace(returncode=code, stderr=capsys.readouterr().err), *fragments)
 
 
 def test_bad_scene_value_names_file_key_and_value(tmp_path):
@@ -98,16 +106,25 @@ def test_info_and_techniques(adapter, capsys):
         assert name in out
 
 
-def test_view_without_display_renders_a_png(tmp_path, adapter):
-    env = {"DISPLAY": "", "WAYLAND_DISPLAY": ""}
+def test_view_without_display_renders_a_png(tmp_path, adapter, monkeypatch, capsys):
+    """Without a display ``view`` renders the scene offscreen at the window size of the settings (small here)."""
+    config = tmp_path / "config"
+    config.mkdir()
+    (config / "settings.toml").write_text("version = 1\nwidth = 160\nheight = 100\n")
+    env = {"DISPLAY": "", "WAYLAND_DISPLAY": "", "WGPUVIEWER_CONFIG_DIR": str(config)}
     result = run_cli("view", env=env, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert "no display" in result.stdout
     out = tmp_path / "out" / "default_pom.png"
     assert out.exists() and result.stdout.strip().endswith(str(Path("out") / "default_pom.png"))
-    # no arguments at all = view the default scene
-    result = run_cli(env=env, cwd=tmp_path)
-    assert result.returncode == 0 and "no display" in result.stdout
+    assert cv2.imread(str(out)).shape == (100, 160, 3)
+    # no arguments at all = view the default scene (in this process)
+    out.unlink()
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    monkeypatch.chdir(tmp_path)
+    assert main([]) == 0
+    assert "no display" in capsys.readouterr().out and out.exists()
 
 
 def test_every_study_folder_is_a_registered_subcommand():

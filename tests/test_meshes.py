@@ -10,8 +10,6 @@ import io
 import json
 import logging
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -417,10 +415,13 @@ def test_mesh_keys_on_a_builtin_are_refused(tmp_path):
         load_scene(path)
 
 
-def test_render_command_reports_a_bad_mesh_in_one_line(tmp_path):
+def test_render_command_reports_a_bad_mesh_in_one_line(tmp_path, capsys):
+    """In this process (the CLI's exit status through its own process: tests/test_mesh_fuzz.py)."""
+    from wgpuviewer.cli import main
+
     scene = mesh_scene(tmp_path, bad_gltf("a.gltf", uv=None)(tmp_path))
-    result = subprocess.run([sys.executable, "-m", "wgpuviewer", "render", str(scene), "-o", str(tmp_path / "x.png")],
-                            capture_output=True, text=True, timeout=120)
-    assert result.returncode == 2, result.stderr
-    lines = [line for line in result.stderr.splitlines() if line.startswith("wgpuviewer: error")]
-    assert len(lines) == 1 and "no TEXCOORD_0" in lines[0] and "Traceback" not in result.stderr
+    assert main(["render", str(scene), "-o", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if line.startswith("wgpuviewer: error")]
+    assert len(lines) == 1 and "no TEXCOORD_0" in lines[0] and "Traceback" not in err
+    assert not (tmp_path / "x.png").exists()

@@ -18,6 +18,8 @@ from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_fro
 from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.textures import builtin_height
 
+from .batched import probe_batches
+
 RAY_SEARCH = [name for name, t in TECHNIQUES.items() if t.ray_search]
 EXACT = [name for name in RAY_SEARCH if TECHNIQUES[name].exact]
 MAPS = ("bricks", "bumps", "flat0", "flat1", "spike", "step", "wall", "checker")
@@ -53,16 +55,18 @@ def test_every_ray_search_declares_its_coverage():
             assert resolve_params(t, params) != t.defaults(), (name, params)
 
 
+GRAZING = (85.0, 89.0, 89.9)
+
+
 @pytest.mark.parametrize(("technique", "params"), settings(RAY_SEARCH))
-@pytest.mark.parametrize("angle", [85.0, 89.0, 89.9])
-def test_grazing_views_are_finite_and_bounded(gpu, technique, params, angle):
+def test_grazing_views_are_finite_and_bounded(gpu, technique, params):
     most = bound(technique, params)
-    uv, view = random_rays(256, angle, seed=int(angle * 10))
+    batches = [random_rays(256, angle, seed=int(angle * 10)) for angle in GRAZING]
     for name in MAPS:
-        got = probe(technique, height_map(name), uv, view, 0.05, **params)
-        assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all(), name
-        assert ((got.depth >= 0) & (got.depth <= 1)).all(), name
-        assert got.fetches.max() <= most, (name, int(got.fetches.max()), most)
+        for angle, got in zip(GRAZING, probe_batches(technique, height_map(name), batches, 0.05, **params)):
+            assert np.isfinite(got.uv).all() and np.isfinite(got.depth).all(), (name, angle)
+            assert ((got.depth >= 0) & (got.depth <= 1)).all(), (name, angle)
+            assert got.fetches.max() <= most, (name, angle, int(got.fetches.max()), most)
 
 
 @pytest.mark.parametrize(("technique", "params"), settings(RAY_SEARCH))
@@ -79,10 +83,11 @@ def test_horizontal_and_back_facing_views_are_finite_and_flagged(gpu, technique,
 @pytest.mark.parametrize(("technique", "params"), settings(RAY_SEARCH))
 def test_fetches_within_the_declared_bound(gpu, technique, params):
     most = bound(technique, params)
-    for angle in (0.0, 45.0, 80.0):
-        uv, view = random_rays(512, angle, seed=7)
-        for name in ("bricks", "checker", "spike"):
-            got = probe(technique, height_map(name), uv, view, 0.05, **params)
+    angles = (0.0, 45.0, 80.0)
+    batches = [random_rays(512, angle, seed=7) for angle in angles]
+    for name in ("bricks", "checker", "spike"):
+        for angle, (uv, _), got in zip(angles, batches, probe_batches(technique, height_map(name), batches, 0.05,
+                                                                      **params)):
             assert got.fetches.max() <= most, (name, angle, int(got.fetches.max()))
             # fetches are counted: a ray that fetched nothing did not move (auto's basic candidate)
             idle = got.fetches == 0
@@ -93,9 +98,9 @@ def test_fetches_within_the_declared_bound(gpu, technique, params):
 @pytest.mark.parametrize("name", MAPS)
 def test_exact_tracers_never_pass_the_first_hit(gpu, technique, params, name):
     h = height_map(name)
-    for angle in (0.0, 30.0, 60.0, 80.0, 85.0, 89.0):
-        uv, view = random_rays(512, angle, seed=int(angle))
-        got = probe(technique, h, uv, view, 0.05, **params)
+    angles = (0.0, 30.0, 60.0, 80.0, 85.0, 89.0)
+    batches = [random_rays(512, angle, seed=int(angle)) for angle in angles]
+    for angle, (uv, view), got in zip(angles, batches, probe_batches(technique, h, batches, 0.05, **params)):
         ref = exact_hit(1.0 - h, uv, view, 0.05)
         ok = ref.valid
         assert (got.depth[ok] <= ref.t[ok] + T_TOL).all(), (angle, float(np.max(got.depth[ok] - ref.t[ok])))
@@ -126,12 +131,11 @@ EXACT_TEXELS = 0.01
 @pytest.mark.parametrize("name", ("wall", "step", "spike", "checker"))
 def test_exact_tracers_on_axis_aligned_rays(gpu, technique, name):
     h = height_map(name)
-    for angle in (45.0, 80.0, 85.0):
-        for azimuth in (0.0, 90.0, 180.0, 270.0):
-            uv, view = axis_aligned_rays(64, angle, azimuth)
-            got = probe(technique, h, uv, view, 0.05)
-            ref = exact_hit(1.0 - h, uv, view, 0.05)
-            ok = ref.valid & ~got.capped
-            assert ok.mean() >= 0.99, (angle, azimuth, ok.mean())
-            err = uv_error_texels(got.uv[ok], ref.uv[ok], h.shape)
-            assert err.max() <= EXACT_TEXELS, (angle, azimuth, float(err.max()))
+    cases = [(angle, azimuth) for angle in (45.0, 80.0, 85.0) for azimuth in (0.0, 90.0, 180.0, 270.0)]
+    batches = [axis_aligned_rays(64, angle, azimuth) for angle, azimuth in cases]
+    for (angle, azimuth), (uv, view), got in zip(cases, batches, probe_batches(technique, h, batches, 0.05)):
+        ref = exact_hit(1.0 - h, uv, view, 0.05)
+        ok = ref.valid & ~got.capped
+        assert ok.mean() >= 0.99, (angle, azimuth, ok.mean())
+        err = uv_error_texels(got.uv[ok], ref.uv[ok], h.shape)
+        assert err.max() <= EXACT_TEXELS, (angle, azimuth, float(err.max()))

@@ -16,6 +16,8 @@ from wgpuviewer.relief.probe import probe
 from wgpuviewer.relief.reference import exact_hit, uv_error_texels, view_dir_from_angles
 from wgpuviewer.textures import BUILTINS, builtin_height
 
+from .batched import probe_batches
+
 WALKS = ("maxmip", "quadmax", "distance", "distance_refined", "cone")
 SCALE = 0.05
 #: Float tolerance for "never behind the first hit", in layer depth t (as tests/relief/test_contracts.py).
@@ -51,18 +53,17 @@ def test_a_ray_passing_just_above_a_peak_misses_it(gpu, technique):
     the spike's tip on a border meets that continuation just past it. Only a root within rounding of the border
     counts (common/cell.wgsl): these rays miss the tip, and the ones that dip as far into it hit it."""
     h = builtin_height("spike", (64, 64))
-    for angle, margin in TIP_MARGINS.items():
-        for m in (margin, -margin):
-            uv, view = tip_rays(64, angle, m)
-            got = probe(technique, h, uv, view, SCALE)
-            ref = exact_hit(1.0 - h, uv, view, SCALE)
-            # past a missed tip the ray may have far to go: the walks without a pyramid hand it over to maxmip's
-            done = ~got.capped
-            assert done.all(), (angle, m)
-            assert (np.abs(got.depth - ref.t)[done] <= T_TOL).all(), (angle, m, got.depth, ref.t)
-            assert (got.depth <= ref.t + T_TOL).all(), (angle, m)
-            # the ray is at depth 0.05 - m at P: the dip's hit is there, a missed tip's lies beyond
-            assert ((ref.t <= 0.05 - m) if m < 0 else (ref.t > 0.05)).all(), (angle, m, ref.t)
+    cases = [(angle, m) for angle, margin in TIP_MARGINS.items() for m in (margin, -margin)]
+    batches = [tip_rays(64, angle, m) for angle, m in cases]
+    for (angle, m), (uv, view), got in zip(cases, batches, probe_batches(technique, h, batches, SCALE)):
+        ref = exact_hit(1.0 - h, uv, view, SCALE)
+        # past a missed tip the ray may have far to go: the walks without a pyramid hand it over to maxmip's
+        done = ~got.capped
+        assert done.all(), (angle, m)
+        assert (np.abs(got.depth - ref.t)[done] <= T_TOL).all(), (angle, m, got.depth, ref.t)
+        assert (got.depth <= ref.t + T_TOL).all(), (angle, m)
+        # the ray is at depth 0.05 - m at P: the dip's hit is there, a missed tip's lies beyond
+        assert ((ref.t <= 0.05 - m) if m < 0 else (ref.t > 0.05)).all(), (angle, m, ref.t)
 
 
 @pytest.mark.parametrize("name", list(BUILTINS))
@@ -72,11 +73,11 @@ def test_walks_are_uncapped_and_exact_at_grazing_angles(gpu, name):
     walk) on it to float32 precision, quadmax to its leaves' 6e-5 depth quantisation (at 89.9 degrees the ray travels
     1833 texels per unit depth: 0.11 texel)."""
     h = builtin_height(name, (64, 64))
-    for angle in (89.0, 89.5, 89.9):
-        uv, view = random_rays(512, angle, seed=int(angle * 10))
-        ref = exact_hit(1.0 - h, uv, view, SCALE)
-        for technique in WALKS:
-            got = probe(technique, h, uv, view, SCALE)
+    angles = (89.0, 89.5, 89.9)
+    batches = [random_rays(512, angle, seed=int(angle * 10)) for angle in angles]
+    refs = [exact_hit(1.0 - h, uv, view, SCALE) for uv, view in batches]
+    for technique in WALKS:
+        for angle, ref, got in zip(angles, refs, probe_batches(technique, h, batches, SCALE)):
             assert not got.capped.any(), (technique, angle)
             assert (got.depth <= ref.t + T_TOL).all(), (technique, angle)
             err = uv_error_texels(got.uv, ref.uv, (64, 64))
@@ -91,9 +92,9 @@ def test_the_search_starts_at_the_maps_shallowest_depth(gpu, technique):
     goes straight to its hit. From t = 0 each sphere or cone step would close about 1/tan of the gap to the floor,
     and the caps would stop every ray."""
     h = builtin_height("flat0", (64, 64))
-    for angle in (89.9, NEAR_CLAMP):
-        uv, view = random_rays(256, angle, seed=2)
-        got = probe(technique, h, uv, view, SCALE)
+    angles = (89.9, NEAR_CLAMP)
+    batches = [random_rays(256, angle, seed=2) for angle in angles]
+    for angle, (uv, view), got in zip(angles, batches, probe_batches(technique, h, batches, SCALE)):
         assert not got.capped.any(), angle
         span = view[:, :2] / view[:, 2:3] * SCALE
         reach = math.tan(math.radians(angle)) * SCALE * 64  # texels per unit depth

@@ -30,6 +30,8 @@ from wgpuviewer.techniques import TECHNIQUES
 from wgpuviewer.techniques.shared import HANDOVER_STEPS, PYRAMID_STEPS
 from wgpuviewer.textures import builtin_height
 
+from .batched import probe_batches
+
 REAL = ("bricks", "bumps", "ridges")
 HARD = ("flat0", "flat1", "spike", "step", "wall", "checker")
 EXACT = ("maxmip", "distance", "distance_refined")  # first hit of the bilinear surface, float32 precision
@@ -143,9 +145,9 @@ def test_exact_tracers_find_the_first_hit(gpu, technique, name):
     never behind the first hit is a contract of every exact tracer: test_contracts.py)."""
     h = height_map(name)
     ref_depth = 1.0 - h
-    for angle in (0, 60, 80, 85):
-        uv, view = random_rays(512, angle, seed=angle)
-        got = probe(technique, h, uv, view, 0.05)
+    angles = (0, 60, 80, 85)
+    batches = [random_rays(512, angle, seed=angle) for angle in angles]
+    for angle, (uv, view), got in zip(angles, batches, probe_batches(technique, h, batches, 0.05)):
         ref = exact_hit(ref_depth, uv, view, 0.05)
         ok = ~got.capped
         assert ok.mean() >= 0.99, (angle, ok.mean())

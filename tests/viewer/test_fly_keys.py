@@ -139,18 +139,21 @@ def test_the_run_loop_holds_fly_keys_and_presses_the_others():
 
 
 def test_a_hold_moves_the_window_camera_the_same_in_one_piece_or_two(display, adapter, tmp_path):
-    """A real window: W:0.4 and w:0.2,W:0.2 end at the same camera (the same pixels), which is not the start."""
+    """A real window: W:0.4 and w:0.2,W:0.2 end at the same camera (the same pixels), which is not the start (the
+    second run's P shot, before its holds)."""
 
-    def shot(keys: str) -> np.ndarray:
-        out = tmp_path / f"{len(list(tmp_path.iterdir()))}.png"
+    def shot(keys: str, cwd) -> np.ndarray:
+        cwd.mkdir()
+        out = cwd / "end.png"
         env = {**os.environ, "DISPLAY": display, "WGPUVIEWER_CONFIG_DIR": str(tmp_path / "config")}
         result = subprocess.run([sys.executable, "-c", RUNNER, "view", "--technique", "basic", "--size", "160x100",
                                  "--keys", keys, "--screenshot", str(out)],
-                                capture_output=True, text=True, timeout=300, env=env, cwd=tmp_path)
+                                capture_output=True, text=True, timeout=300, env=env, cwd=cwd)
         assert result.returncode == 0, result.stderr
         assert not [line for line in result.stderr.splitlines() if line.startswith("ERROR")], result.stderr
         return cv2.imread(str(out)).astype(int)
 
-    start, whole, halves = shot("H"), shot("H,W:0.4"), shot("H,w:0.2,W:0.2")
+    whole, halves = shot("H,W:0.4", tmp_path / "whole"), shot("H,P,w:0.2,W:0.2", tmp_path / "halves")
+    (start,) = [cv2.imread(str(p)).astype(int) for p in (tmp_path / "halves").glob("wgpuviewer-*-basic-*.png")]
     assert np.abs(whole - start).mean() > 1.0  # the camera moved
     assert np.abs(whole - halves).max() == 0

@@ -1,7 +1,9 @@
 """The window: scripted sessions under a (virtual) X display (glfw, the adapter wgpu picks).
 
 Each run is a real window replaying keys one per frame; runs are shared between tests (module
-cache) and kept small (320x200, 4 frames) so the whole file stays within a few seconds per run.
+cache) and kept small (320x200, a few frames) so the whole file stays within a few seconds per run. The views
+the tests compare (techniques, cost and error views, the A/B split, filters) come from one session that presses
+P (a scene-only screenshot) at each of them: starting a window process is the slow part.
 """
 
 from __future__ import annotations
@@ -22,6 +24,19 @@ RUNNER = (
     "from wgpuviewer.cli import main; sys.exit(main(sys.argv[1:]))"
 )
 SMALL = "320x200"
+#: RUNNER whose P screenshots are numbered in the order taken (the viewer's own names carry the technique and the
+#: second, so two of one technique within a second would share a file): a session's shots, one per view.
+NUMBERED_SHOTS = (
+    "import itertools, pathlib; from wgpuviewer.relief.output import save_rgb_png; from wgpuviewer.viewer.app import "
+    "Viewer; shots = itertools.count();"
+    "Viewer.screenshot = lambda self, texture: save_rgb_png(pathlib.Path.cwd() / f'shot-{next(shots)}.png', "
+    "self.read_frame(texture));" + RUNNER
+)
+#: The views of one session, each the name of the P shot taken at it: from H (no HUD), pom, normal (2, and 1 then
+#: Right), pom's cost view (Shift+D) and error view (Shift+E), the A/B split basic | pom, then pom | pom with B's
+#: filter cycled twice (trilinear -> aniso -> ewa) and its derivative source once (uv -> displaced).
+VIEWS = (("pom", "5"), ("normal", "2"), ("cycled", "1,ArrowRight"), ("cost", "5,D"), ("error", "D,E"),
+         ("split", "E,1,B,Tab,5"), ("filters", "Tab,5,Tab,f,f,F"))
 
 
 class Run:
@@ -29,14 +44,19 @@ class Run:
         self.image, self.stderr, self.cwd = image, stderr, cwd
 
 
+def read_rgb(path) -> np.ndarray:
+    image = cv2.imread(str(path))
+    assert image is not None and image.shape[2] == 3, path
+    return cv2.cvtColor(image, cv2.COLOR_BGR2RGB).astype(np.int16)
+
+
 @pytest.fixture(scope="module")
 def runs(display, adapter, tmp_path_factory):
-    """``runs(name, keys, size=SMALL, settings_text=None)`` -> Run, each distinct run made once."""
+    """``runs(name, keys, size=SMALL, settings_text=None)`` -> Run, each distinct run made once; a name of
+    ``VIEWS`` -> its shot of the one session that shows them all."""
     cache = {}
 
-    def run(name: str, keys: str, size: str = SMALL, settings_text: str | None = None) -> Run:
-        if name in cache:
-            return cache[name]
+    def start(name: str, keys: str, size: str, settings_text: str | None, code: str) -> tuple:
         work = tmp_path_factory.mktemp(name)
         config = work / "config"
         config.mkdir()
@@ -44,7 +64,7 @@ def runs(display, adapter, tmp_path_factory):
             (config / "settings.toml").write_text(settings_text)
         shot = work / f"{name}.png"
         result = subprocess.run(
-            [sys.executable, "-c", RUNNER, "view", "--size", size, "--frames", str(len(keys.split(",")) + 2),
+            [sys.executable, "-c", code, "view", "--size", size, "--frames", str(len(keys.split(",")) + 2),
              "--screenshot", str(shot), "--keys", keys],
             capture_output=True, text=True, timeout=300, cwd=work,
             env={**os.environ, "DISPLAY": display, "WGPUVIEWER_CONFIG_DIR": str(config)},
@@ -52,10 +72,22 @@ def runs(display, adapter, tmp_path_factory):
         assert result.returncode == 0, result.stderr
         errors = [line for line in result.stderr.splitlines() if line.startswith("ERROR")]
         assert not errors, errors
-        image = cv2.imread(str(shot))
-        assert image is not None and image.shape[2] == 3
         assert not (config / "settings.toml").exists() or settings_text is not None  # scripted: no save
-        cache[name] = Run(cv2.cvtColor(image, cv2.COLOR_BGR2RGB).astype(np.int16), result.stderr, work)
+        return work, shot, result.stderr
+
+    def run(name: str, keys: str = "", size: str = SMALL, settings_text: str | None = None) -> Run:
+        if name in cache:
+            return cache[name]
+        if name in dict(VIEWS):
+            keys = "H," + ",".join(f"{view_keys},P" for _, view_keys in VIEWS)
+            work, _, stderr = start("views", keys, SMALL, None, NUMBERED_SHOTS)
+            shots = sorted(work.glob("shot-*.png"), key=lambda p: int(p.stem.split("-")[1]))
+            assert len(shots) == len(VIEWS), stderr
+            for (view, _), path in zip(VIEWS, shots):
+                cache[view] = Run(read_rgb(path), stderr, work)
+            return cache[name]
+        work, shot, stderr = start(name, keys, size, settings_text, RUNNER)
+        cache[name] = Run(read_rgb(shot), stderr, work)
         return cache[name]
 
     return run
@@ -63,9 +95,9 @@ def runs(display, adapter, tmp_path_factory):
 
 def test_keys_switch_techniques(runs):
     basic = runs("basic", "H,1,P").image  # H hides the HUD: pure scene pixels
-    pom = runs("pom", "H,5").image
-    normal = runs("normal", "H,2").image
-    cycled = runs("cycled", "H,1,ArrowRight").image
+    pom = runs("pom").image
+    normal = runs("normal").image
+    cycled = runs("cycled").image  # 1 then Right
     assert np.abs(basic - pom).mean() > 1.0
     assert np.abs(basic - normal).mean() > 0.1
     assert np.abs(cycled - normal).max() == 0  # Right from technique 1 is technique 2
@@ -82,9 +114,9 @@ def test_screenshot_key_writes_png(runs):
 
 
 def test_cost_and_error_views(runs):
-    pom = runs("pom", "H,5").image
-    cost = runs("cost", "H,5,D").image
-    error = runs("error", "H,5,E").image
+    pom = runs("pom").image
+    cost = runs("cost").image  # pom, Shift+D
+    error = runs("error").image  # pom, Shift+E
     assert np.abs(pom - cost).mean() > 5
     assert np.abs(pom - error).mean() > 5
     # Heat colours: red >= green >= blue wherever the error map painted something.
@@ -95,7 +127,7 @@ def test_cost_and_error_views(runs):
 
 
 def test_hud_appears_and_h_hides_it_and_corrupt_settings_are_survived(runs):
-    hidden = runs("pom", "H,5").image
+    hidden = runs("pom").image
     # The HUD run also starts from a corrupt settings file: defaults, a warning, no crash.
     hud = runs("hud", "5", settings_text="width = = [broken\n")
     assert "corrupt" in hud.stderr and "using default settings" in hud.stderr
@@ -107,8 +139,8 @@ def test_hud_appears_and_h_hides_it_and_corrupt_settings_are_survived(runs):
 
 def test_split_view_shows_two_techniques(runs):
     basic = runs("basic", "H,1,P").image
-    pom = runs("pom", "H,5").image
-    split = runs("split", "H,1,B,Tab,5").image  # A = basic, Tab makes B active, 5 = pom on the right
+    pom = runs("pom").image
+    split = runs("split").image  # A = basic, Tab makes B active, 5 = pom on the right
     left, right = slice(0, 150), slice(170, 320)
     assert np.abs(split[:, left] - basic[:, left]).mean() < 0.5
     assert np.abs(split[:, right] - pom[:, right]).mean() < 0.5
@@ -118,8 +150,8 @@ def test_split_view_shows_two_techniques(runs):
 def test_filter_key_changes_the_active_half_only(runs):
     """F cycles the active half's texture filter, Shift+F its derivative source: B = pom with EWA on the displaced
     uv (trilinear -> aniso -> ewa), A stays pom with trilinear."""
-    pom = runs("pom", "H,5").image
-    split = runs("filters", "H,5,B,Tab,5,f,f,F")
+    pom = runs("pom").image
+    split = runs("filters")  # A = pom; B = pom, f, f, F
     left, right = slice(0, 150), slice(170, 320)
     assert np.abs(split.image[:, left] - pom[:, left]).mean() < 0.5
     assert np.abs(split.image[:, right] - pom[:, right]).mean() > 0.3
