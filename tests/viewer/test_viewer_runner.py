@@ -7,6 +7,7 @@ import contextlib
 import logging
 import os
 import signal
+import sys
 
 import pytest
 import wgpu
@@ -104,22 +105,24 @@ def test_a_screenshot_the_script_closed_before_is_an_error(tmp_path):
 @pytest.mark.parametrize("frames", [None, 4])
 def test_a_signal_during_a_draw_ends_the_run_as_escape_does(capsys, sig, code, said, frames):
     """The signal lands inside a draw: the draw finishes, the loop closes the window, no frame is drawn after; the
-    run returns 130/143 with one line, interactive or scripted, and the handlers from before are back."""
+    run returns 130/143 with one line, interactive or scripted, the last one (after what ``on_end``, the session's
+    save, says), and the handlers from before are back."""
     before = {s: signal.getsignal(s) for s in runner.QUIT_SIGNALS}
     window = ToolkitWindow(asks=8)
     viewer = FakeViewer(window, signal_at=(1, sig))
-    assert runner.run(viewer, frames=frames) == code
+    assert runner.run(viewer, frames=frames, on_end=lambda: print("settings saved", file=sys.stderr)) == code
     assert viewer.events == ["draw", "draw", "drawn on", "stop builds"] and window.closed
-    assert capsys.readouterr().err == f"wgpuviewer: {said}\n"
+    assert capsys.readouterr().err == f"settings saved\nwgpuviewer: {said}\n"
     assert {s: signal.getsignal(s) for s in runner.QUIT_SIGNALS} == before
 
 
 def test_an_error_in_a_frame_ends_a_scripted_run_and_is_raised_after_the_loop():
     window = ToolkitWindow(asks=5)
     viewer = FakeViewer(window, fail_at=1)
+    ended = []
     with pytest.raises(UserError, match="cannot write"):
-        runner.run(viewer, frames=4)
-    assert viewer.events == ["draw", "draw", "stop builds"] and window.closed
+        runner.run(viewer, frames=4, on_end=lambda: ended.append(True))
+    assert viewer.events == ["draw", "draw", "stop builds"] and window.closed and not ended
 
 
 @pytest.fixture

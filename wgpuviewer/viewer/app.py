@@ -489,9 +489,9 @@ def run_viewer(
     if not scripted:
         print("keys: F1 help, 1-9 technique, F filter, B A/B split, Shift+D cost, Shift+E error, H hide UI, Esc quit",
               file=sys.stderr)
-    code = runner.run(viewer, frames, screenshot, keys)
-    if save if save is not None else not scripted:
-        save_session(viewer.current_settings())
+    saves = save if save is not None else not scripted
+    code = runner.run(viewer, frames, screenshot, keys,
+                      on_end=(lambda: save_session(viewer.current_settings())) if saves else None)
     if code == 0 and scripted and viewer.problems:  # a scripted run reports what the HUD showed
         print(f"wgpuviewer: error: {viewer.problems[0]}", file=sys.stderr)
         return 2

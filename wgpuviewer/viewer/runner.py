@@ -73,9 +73,10 @@ def _stalled(state: dict) -> bool:
     return state["cancelled"] >= STALL_FRAMES and time.perf_counter() - state["drawn_at"] >= STALL_SECONDS
 
 
-def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=()) -> int:
+def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=(), on_end=None) -> int:
     """Draw ``viewer`` in its window until it closes (interactive: ``frames`` None) or for ``frames`` frames,
-    playing the ``--keys`` items ``keys``."""
+    playing the ``--keys`` items ``keys``; ``on_end()`` runs once the window is closed, unless a frame's error ends the
+    run (before the run's last line, so that a signal's line stays the last)."""
     state = {"frame": 0, "cancelled": 0, "drawn_at": time.perf_counter()}
     pending = parse_script(keys)
     window = viewer.window
@@ -127,6 +128,8 @@ def run(viewer, frames: int | None = None, screenshot: str | None = None, keys=(
         viewer.stop_builds()
         for name in LOGGERS:
             logging.getLogger(name).removeHandler(errors)
+    if on_end is not None and "error" not in state:
+        on_end()
     if signalled is not None:
         code, said = QUIT_SIGNALS[signalled]
         print(f"wgpuviewer: {said}", file=sys.stderr)
