@@ -1,7 +1,7 @@
 """docs/perspective.md's generated blocks, made from the committed runs; ``wgpuviewer docs`` writes them
 (``wgpuviewer.lab.docs``). They compute from the committed CSVs and measure nothing.
 
-From the full run (``benchmarks/perspective/``: results.csv, tieback.csv):
+From the full run (``benchmarks/perspective/``: results.csv, tieback.csv, threads.csv):
 
 - ``perspective recommendation``: the cheapest method within the budget per regime and what the table means
   (``report.recommendation``, the report's own section);
@@ -11,9 +11,6 @@ From the full run (``benchmarks/perspective/``: results.csv, tieback.csv):
   (``drift_lines``);
 - ``perspective tieback``: the relief techniques' hit error at large texture coordinates and where it passes a
   tenth of a texel (``tables.tieback_table``, ``tieback_limit``).
-
-From the threaded run (``benchmarks/perspective_threads/threads.csv``):
-
 - ``perspective threads``: the parallel forms (k lanes, two ends) and whole spans timed on 1, 2 and all of the
   machine's threads beside the scalar and SIMD builds, the core count and the recommendation revisited
   (``threads_report.section``)."""
@@ -36,7 +33,8 @@ from .tables import tieback_table
 from .threaded import THREADS_TABLE
 
 RUN = "benchmarks/perspective"
-THREADS_RUN = "benchmarks/perspective_threads"
+#: The threaded timing: the full run times it too (``--threads-only`` times only it).
+THREADS_RUN = RUN
 #: The tie-back's limit: a tenth of a texel of hit error.
 TIEBACK_BOUND = 0.1
 

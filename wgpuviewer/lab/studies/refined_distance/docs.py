@@ -6,10 +6,10 @@
 - ``refined distance bake times`` (maps.md): the plain and refined bakes' times per size and path;
 - ``refined distance savings`` (techniques.md): the refined map's fetch savings against ``distance`` and the
   baseline, over the run's maps;
-- ``refined distance worked example`` (maps.md): the paper's point C rebuilt (the bound's run,
-  ``benchmarks/refined_distance/bounded/``: example.csv, worked_example.png);
+- ``refined distance worked example`` (maps.md): the paper's point C rebuilt (the same run's example.csv,
+  worked_example.png);
 - ``refined distance bounded`` (maps.md): per map class, what the exact-visibility bound saves and what the
-  conservative cut gets of it (the bound's run: bounded.csv, bounded_maps.csv);
+  conservative cut gets of it (the same run's bounded.csv, bounded_maps.csv);
 - ``refined distance cost`` (maps.md): every map's fetches per height map and angle with the changes, the GPU
   renderer's agreement with the twin, the capped pixels;
 - ``refined distance result``, ``... ablation`` (maps.md): what the condition and the bins change, and each bin
@@ -32,8 +32,8 @@ from .run import COSTS_TABLE, DONNELLY_TABLE, FORMATS_TABLE, TABLE
 from .variants import CONDITION_PAIRS, OTHER_STORAGES, SINGLE_CONE
 
 RUN = "benchmarks/refined_distance"
-#: The bound's run (``--only bounded``): the worked example and the exact-visibility maps.
-BOUND = f"{RUN}/bounded"
+#: The worked example and the exact-visibility maps: the full run writes them beside its other results.
+BOUND = RUN
 TWIN = "numpy twin"
 DISTANCE, BASELINE, REFINED = "plain K=4", "plain before (maptools-2)", "4 sectors x 8 bands"
 MIDDLE = (45.0, 60.0, 75.0, 80.0)  # "45-80°"
