@@ -32,16 +32,18 @@ KEYS = "H,5"  # the HUD hidden (the offscreen render has none), then pom by its 
 PANIC = "panicked"  # what wgpu-native prints before it aborts
 
 #: ``view`` in a window, keeping the window's own pixels (X11: XGetImage) after its last frame was presented, in the
-#: .npy given first.
+#: .npy given first: grabbed again until they are the screenshot's frame (the last present may land a moment later,
+#: and until then the window shows an earlier frame), for at most two seconds.
 WINDOW_RUNNER = """
 import ctypes, sys, time
-import glfw, numpy as np
+import cv2, glfw, numpy as np
 from wgpuviewer.viewer.window import Window
 from wgpuviewer.cli import main
 
 def grab(window):
     if glfw.get_platform() != glfw.PLATFORM_X11:
         return
+    shot = cv2.imread(sys.argv[sys.argv.index("--screenshot") + 1])[..., ::-1].astype(np.int16)
     x = ctypes.CDLL("libX11.so.6")
     x.XGetImage.restype = ctypes.c_void_p
     x.XGetImage.argtypes = [ctypes.c_void_p, ctypes.c_ulong] + [ctypes.c_int] * 2 + [ctypes.c_uint] * 2 + [
@@ -53,10 +55,11 @@ def grab(window):
         image = x.XGetImage(int(getattr(display, "value", display)), glfw.get_x11_window(window.canvas._window),
                             0, 0, w, h, 0xFFFFFFFF, 2)
         pixels = np.array([[x.XGetPixel(image, i, j) for i in range(w)] for j in range(h)], np.uint64)
-        if pixels.any():
+        rgb = np.stack([pixels >> 16, pixels >> 8, pixels], -1).astype(np.uint8)
+        if rgb.shape == shot.shape and np.abs(rgb.astype(np.int16) - shot).max() <= 1:
             break
         time.sleep(0.02)
-    np.save(sys.argv[1], np.stack([pixels >> 16, pixels >> 8, pixels], -1).astype(np.uint8))
+    np.save(sys.argv[1], rgb)
 
 def close(self):  # Window.close, grabbing the window before it goes
     if not self.closed:
