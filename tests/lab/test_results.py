@@ -119,3 +119,14 @@ def test_a_stamp_of_another_definition_is_stale(checkout):
     record = stamp.read(folder)
     stamp.write(folder, {**record, "definition": stamp.DEFINITION + 1, "parts": {"layers 32": "0"}})
     assert results.freshness(checkout, "benchmarks/pom_run").status() == "stale: the fingerprint's definition changed"
+
+
+@pytest.mark.parametrize("entry", ["filter_probe", "shadow_probe", "gradient_probe"])
+def test_a_changed_probe_entry_is_named(checkout, entry):
+    """The filtering and shadow studies measure through these entry points: a change to one stales every folder."""
+    parts = stamp.parts_for(stamp.Files(checkout), {"pom"}, ("ewa",), "wgpuviewer/lab/bench")
+    before = stamp.fingerprint(stamp.Files(checkout), parts)
+    source = checkout / "wgsl" / "entry" / f"{entry}.wgsl"
+    source.write_text(source.read_text() + "// one more line\n")
+    after = stamp.fingerprint(stamp.Files(checkout), parts)
+    assert [p for p in parts if before[p] != after[p]] == [f"entry {entry}"]

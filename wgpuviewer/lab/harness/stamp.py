@@ -11,7 +11,8 @@ differs too:
 - ``map KIND``: the folder of every map kind the technique's entry names (``maptools/kinds/KIND/``), with the WGSL
   it includes and the ``maptools/...wgsl`` kernels its drivers name;
 - ``filter NAME``: ``wgsl/filters/NAME.wgsl`` with what it includes, for the filters the results name;
-- ``entry probe``, ``entry render``: the probe's and the renderer's entry points with what they include;
+- ``entry NAME``: the entry points a measurement can run, with what they include: the probe's, the renderer's and
+  the filter, gradient and shadow probes' (``ENTRIES``; the viewer's own passes are left out);
 - ``code PACKAGE``: the Python of the measuring command's own package (``wgpuviewer/lab/bench``, a study's folder),
   but its ``docs.py`` (which only formats the results into pages).
 
@@ -39,11 +40,11 @@ from wgpuviewer.core.io import write_bytes
 from wgpuviewer.core.wgsl import includes
 
 STAMP = "stamp.json"
-DEFINITION = 1  # the fingerprint's definition (this docstring); a stamp of another definition is stale
+DEFINITION = 2  # the fingerprint's definition (this docstring); a stamp of another definition is stale
 CHECKOUT = Path(__file__).resolve().parents[3]
 TECHNIQUES = "wgpuviewer/techniques"
 KINDS = "maptools/kinds"
-ENTRIES = ("probe", "render")
+ENTRIES = ("probe", "render", "filter_probe", "gradient_probe", "shadow_probe")
 _QUOTED = re.compile(r"[\"']([a-z_]+)[\"']")
 _KERNEL = re.compile(r"maptools/[\w/]+\.wgsl")
 
