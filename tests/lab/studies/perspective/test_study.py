@@ -98,7 +98,10 @@ def test_the_speed_rows_compare_every_method_to_direct_in_the_same_run(rows):
         here = [r for r in speed if (r["span_length"], r["spans"]) == frame]
         assert {r["method"] for r in here} == set(METHODS) | {"hardware"}
         direct = next(r for r in here if r["method"] == "direct")
-        assert direct["gpu_ratio"] == direct["scalar_ratio"] == direct["simd_ratio"] == 1.0
+        assert direct["scalar_ratio"] == direct["simd_ratio"] == 1.0
+        # the software adapter's wall-net time of a smoke frame can be all overhead on a busy machine (clamped to 0):
+        # then no method has a GPU ratio to direct, and the row says so
+        assert direct["gpu_ratio"] == 1.0 if direct["gpu_ms"] > 0 else math.isnan(direct["gpu_ratio"])
         methods = [r for r in here if r["method"] != "hardware"]
         assert all(r["scalar_ns"] > 0 and r["simd_ns"] > 0 and r["scalar_spread"] >= 0 for r in methods)
         assert all(r["simd_vectorised"] == "scalar" or r["simd_vectorised"].startswith(("loop x", "slp x"))
