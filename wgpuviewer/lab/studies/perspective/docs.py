@@ -33,8 +33,6 @@ from .tables import tieback_table
 from .threaded import THREADS_TABLE
 
 RUN = "benchmarks/perspective"
-#: The threaded timing: the full run times it too (``--threads-only`` times only it).
-THREADS_RUN = RUN
 #: The tie-back's limit: a tenth of a texel of hit error.
 TIEBACK_BOUND = 0.1
 
@@ -125,7 +123,7 @@ def tieback_body(root: Path) -> str:
 
 
 def threads_body(root: Path) -> str:
-    return "\n".join(["", *threads_report.section(THREADS_TABLE.read(root / THREADS_RUN / threads_report.THREADS_FILE)),
+    return "\n".join(["", *threads_report.section(THREADS_TABLE.read(root / RUN / threads_report.THREADS_FILE)),
                       ""])
 
 
@@ -134,5 +132,5 @@ BLOCKS = (Block("docs/perspective.md", "perspective recommendation", f"{RUN}/res
           Block("docs/perspective.md", "perspective answers", f"{RUN}/results.csv", answers_body, results=RUN),
           Block("docs/perspective.md", "perspective drift", f"{RUN}/results.csv", drift_body, results=RUN),
           Block("docs/perspective.md", "perspective tieback", f"{RUN}/tieback.csv", tieback_body, results=RUN),
-          Block("docs/perspective.md", "perspective threads", f"{THREADS_RUN}/{threads_report.THREADS_FILE}",
-                threads_body, results=THREADS_RUN))
+          Block("docs/perspective.md", "perspective threads", f"{RUN}/{threads_report.THREADS_FILE}",
+                threads_body, results=RUN))

@@ -32,8 +32,6 @@ from .run import COSTS_TABLE, DONNELLY_TABLE, FORMATS_TABLE, TABLE
 from .variants import CONDITION_PAIRS, OTHER_STORAGES, SINGLE_CONE
 
 RUN = "benchmarks/refined_distance"
-#: The worked example and the exact-visibility maps: the full run writes them beside its other results.
-BOUND = RUN
 TWIN = "numpy twin"
 DISTANCE, BASELINE, REFINED = "plain K=4", "plain before (maptools-2)", "4 sectors x 8 bands"
 MIDDLE = (45.0, 60.0, 75.0, 80.0)  # "45-80°"
@@ -98,24 +96,24 @@ def savings_body(root: Path) -> str:
 
 
 def example_body(root: Path) -> str:
-    r = example.TABLE.read(root / BOUND / "example.csv")[0]
+    r = example.TABLE.read(root / RUN / "example.csv")[0]
     e = [float(x) for x in r["steps_euclidean"].split()]
     f = [float(x) for x in r["steps_refined"].split()]
-    return (f"\nMeasured (`{BOUND}/example.csv`): Euclidean value {float(r['euclidean']):.3f} texels, refined value "
+    return (f"\nMeasured (`{RUN}/example.csv`): Euclidean value {float(r['euclidean']):.3f} texels, refined value "
             f"{float(r['refined']):.3f} (the directions sampled every {example.POLAR_STEP:g}° of polar angle and "
             f"{example.AZIMUTH_STEP:g}° of azimuth: a sampled least free path lies above the exact one), V1's hit "
             f"{float(r['hit_v1']):.3f} texels on at {float(r['horizon']):.1f}°. Donnelly's loop along V1 steps "
             f"{', '.join(f'{x:.3f}' for x in e)} with the Euclidean values and {', '.join(f'{x:.3f}' for x in f)} "
             f"with the refined ones. The product's conservative cut lets rays up to {float(r['cut_single']):.1f}° "
             f"(single cone) and {float(r['cut_sectors']):.1f}° ({example.CUT_SECTORS[-1]} sectors, the one towards "
-            f"A) reach C's voxel.\n\n![the worked example](../{BOUND}/{example.PLOT})\n")
+            f"A) reach C's voxel.\n\n![the worked example](../{RUN}/{example.PLOT})\n")
 
 
 def bounded_body(root: Path) -> str:
-    rows = bounded.TABLE.read(root / BOUND / "bounded.csv")
+    rows = bounded.TABLE.read(root / RUN / "bounded.csv")
     for r in rows:
         r["angle"], r["fetches_mean"], r["passed"] = float(r["angle"]), float(r["fetches_mean"]), float(r["passed"])
-    maps = bounded.MAPS_TABLE.read(root / BOUND / "bounded_maps.csv")
+    maps = bounded.MAPS_TABLE.read(root / RUN / "bounded_maps.csv")
     classes = bounded.by_class(rows)
     members = {c: sorted({r["heightmap"] for r in rows if r["class"] == c}) for c in classes}
     angles = sorted({r["angle"] for r in rows})
@@ -123,7 +121,7 @@ def bounded_body(root: Path) -> str:
     def mean(c, v):
         return f"{100 * sum(classes[c][v]) / len(classes[c][v]):+.1f} %"
 
-    lines = ["", f"The run's {rows[0]['size']} maps, views at {', '.join(f'{a:g}' for a in angles)}° (`{BOUND}/bounded.csv`; "
+    lines = ["", f"The run's {rows[0]['size']} maps, views at {', '.join(f'{a:g}' for a in angles)}° (`{RUN}/bounded.csv`; "
              "mean change of fetches against `distance`; *share*: the part of the exact bound's saving the "
              "conservative cut gets):", "",
              "| class (maps) | paper's map, conservative cut | single cone, exact visibility | share | 4 x 8 bins, "
@@ -345,9 +343,9 @@ def formats_body(root: Path) -> str:
 BLOCKS = (Block("docs/maps.md", "refined distance baseline", f"{RUN}/results.csv", baseline_body, results=RUN),
           Block("docs/maps.md", "refined distance bake times", f"{RUN}/formats.csv", bake_body, results=RUN),
           Block("docs/techniques.md", "refined distance savings", f"{RUN}/results.csv", savings_body, results=RUN),
-          Block("docs/maps.md", "refined distance worked example", f"{BOUND}/example.csv", example_body, results=BOUND),
-          Block("docs/maps.md", "refined distance bounded", f"{BOUND}/bounded.csv and {BOUND}/bounded_maps.csv",
-                bounded_body, results=BOUND),
+          Block("docs/maps.md", "refined distance worked example", f"{RUN}/example.csv", example_body, results=RUN),
+          Block("docs/maps.md", "refined distance bounded", f"{RUN}/bounded.csv and {RUN}/bounded_maps.csv",
+                bounded_body, results=RUN),
           Block("docs/maps.md", "refined distance cost", f"{RUN}/results.csv", cost_body, results=RUN),
           Block("docs/maps.md", "refined distance result", f"{RUN}/results.csv", result_body, results=RUN),
           Block("docs/maps.md", "refined distance pits", f"{RUN}/pits.csv", pits_body, results=RUN),
